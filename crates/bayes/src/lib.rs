@@ -1,0 +1,1 @@
+//! chatter-bayes (under construction)

@@ -1,0 +1,101 @@
+//! Reference models shipped with the toolkit: the seeds' cases (the JSON files in the
+//! repository's `examples/` folder, embedded here) and the classic single-DOF milling benchmark.
+//! Tests, benches and `chatter demo` share them.
+
+use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
+use crate::observations::Observations;
+use crate::operation::{Milling, MillingDirection, Operation};
+use std::path::Path;
+
+/// Model file of the turning case of Ahmadi (2022), seed 000, Table 1.
+pub const AHMADI_2022_TURNING_MODEL: &str =
+    include_str!("../../../examples/ahmadi2022_turning_model.json");
+/// Observations of the turning case of seed 000: Table 2 poles and the Fig. 2 cuts.
+pub const AHMADI_2022_TURNING_OBSERVATIONS: &str =
+    include_str!("../../../examples/ahmadi2022_turning_observations.json");
+/// Model file of the milling example of Schmitz (2023), seed 001.
+pub const SCHMITZ_2023_MILLING_MODEL: &str =
+    include_str!("../../../examples/schmitz2023_milling_model.json");
+/// Model file of the experimental milling case of Ebrahimi-Tirtashi and Ahmadi (2025), seed 002.
+pub const EBRAHIMI_2025_MILLING_MODEL: &str =
+    include_str!("../../../examples/ebrahimi2025_milling_model.json");
+/// Observations of seed 002: Table 2 poles and their stable cuts.
+pub const EBRAHIMI_2025_MILLING_OBSERVATIONS: &str =
+    include_str!("../../../examples/ebrahimi2025_milling_observations.json");
+
+fn embedded_model(text: &str, name: &str) -> ModalModel {
+    // The embedded files are checked by this crate's tests; failure here is a build defect.
+    ModalModel::from_json_str(text, Path::new(name))
+        .unwrap_or_else(|e| panic!("embedded example {name} is invalid: {e}"))
+}
+
+fn embedded_observations(text: &str, name: &str) -> Observations {
+    Observations::from_json_str(text, Path::new(name))
+        .unwrap_or_else(|e| panic!("embedded example {name} is invalid: {e}"))
+}
+
+/// Turning tool of seed 000 (Table 1; kt 635, kfc 159 N/mm^2).
+pub fn ahmadi_2022_turning() -> ModalModel {
+    embedded_model(AHMADI_2022_TURNING_MODEL, "ahmadi2022_turning_model.json")
+}
+/// Observations of seed 000 (Table 2 poles, Fig. 2 cuts).
+pub fn ahmadi_2022_turning_observations() -> Observations {
+    embedded_observations(
+        AHMADI_2022_TURNING_OBSERVATIONS,
+        "ahmadi2022_turning_observations.json",
+    )
+}
+/// Milling example of seed 001 (4 teeth, 20 % down milling, 750 Hz, 3 %, 3e6 N/m, x and y).
+pub fn schmitz_2023_milling() -> ModalModel {
+    embedded_model(SCHMITZ_2023_MILLING_MODEL, "schmitz2023_milling_model.json")
+}
+/// Experimental milling case of seed 002 (hammer values before milling).
+pub fn ebrahimi_2025_milling() -> ModalModel {
+    embedded_model(
+        EBRAHIMI_2025_MILLING_MODEL,
+        "ebrahimi2025_milling_model.json",
+    )
+}
+/// Observations of seed 002 (Table 2).
+pub fn ebrahimi_2025_milling_observations() -> Observations {
+    embedded_observations(
+        EBRAHIMI_2025_MILLING_OBSERVATIONS,
+        "ebrahimi2025_milling_observations.json",
+    )
+}
+
+/// The classic single-DOF milling benchmark (Insperger and Stépán 2004; Ding et al. 2010):
+/// fn 922 Hz, zeta 0.011, modal mass 0.03993 kg in x, kt 6e8 and kn 2e8 N/m^2, 2 teeth, down
+/// milling at radial immersion a/D (1 and 0.05 in the literature).
+pub fn insperger_benchmark(radial_immersion: f64) -> ModalModel {
+    let fn_hz = 922.0;
+    let mass_kg = 0.03993;
+    let k = mass_kg * (2.0 * std::f64::consts::PI * fn_hz).powi(2);
+    let build = || -> crate::Result<ModalModel> {
+        let op = Operation::Milling(Milling::new(
+            2,
+            radial_immersion,
+            MillingDirection::Down,
+            None,
+            None,
+        )?);
+        let mode = Mode::new(
+            fn_hz,
+            0.011,
+            ModeShape::Directional {
+                coordinate: 0,
+                stiffness_n_per_m: k,
+            },
+        )?;
+        ModalModel::new(
+            Some(format!(
+                "single-DOF milling benchmark (Insperger and Stepan 2004), a/D = {radial_immersion}"
+            )),
+            op,
+            CuttingCoefficients::new(6e8, 2e8)?,
+            vec![mode],
+            None,
+        )
+    };
+    build().unwrap_or_else(|e| panic!("benchmark with a/D = {radial_immersion}: {e}"))
+}

@@ -1,0 +1,297 @@
+//! Multi-mode modal models (000 Eq. 1-2, 002 Section 2).
+//!
+//! The structure obeys, in modal coordinates q, q'' + 2 Omega Z q' + Omega^2 q = Phi^T f
+//! (000 Eq. 1) with Phi the 2 x N matrix of mass-normalized mode shapes over the operation's
+//! two coordinates. A mode given by a stiffness k in one direction is the mass-normalized shape
+//! omega_n / sqrt(k) in that direction (modal mass k / omega_n^2).
+
+use crate::error::{DynamicsError, Result, finite, non_negative, positive};
+use crate::operation::Operation;
+use std::f64::consts::PI;
+
+/// How a mode's shape (and so its modal mass or stiffness) is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModeShape {
+    /// A mode that moves in one coordinate only, with stiffness `k` (N/m).
+    Directional {
+        /// Index of the coordinate (0 or 1) in [`Operation::coordinates`].
+        coordinate: usize,
+        /// Modal stiffness in N/m.
+        stiffness_n_per_m: f64,
+    },
+    /// Mass-normalized components over the two coordinates, in 1/sqrt(kg).
+    MassNormalized([f64; 2]),
+}
+
+/// One structural mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    frequency_hz: f64,
+    damping_ratio: f64,
+    shape: ModeShape,
+}
+
+impl Mode {
+    /// Validated mode: `frequency_hz > 0`, `0 <= damping_ratio < 1`, positive stiffness or a
+    /// finite, non-zero shape.
+    pub fn new(frequency_hz: f64, damping_ratio: f64, shape: ModeShape) -> Result<Self> {
+        positive("frequency_hz", frequency_hz)?;
+        non_negative("damping_ratio", damping_ratio)?;
+        if damping_ratio >= 1.0 {
+            return Err(DynamicsError::value(
+                "damping_ratio",
+                damping_ratio,
+                "an underdamped ratio in [0, 1)",
+            ));
+        }
+        match shape {
+            ModeShape::Directional {
+                coordinate,
+                stiffness_n_per_m,
+            } => {
+                positive("stiffness_n_per_m", stiffness_n_per_m)?;
+                if coordinate > 1 {
+                    return Err(DynamicsError::value(
+                        "direction",
+                        coordinate as f64,
+                        "coordinate index 0 or 1",
+                    ));
+                }
+            }
+            ModeShape::MassNormalized(phi) => {
+                finite("shape", phi[0])?;
+                finite("shape", phi[1])?;
+                if phi[0] == 0.0 && phi[1] == 0.0 {
+                    return Err(DynamicsError::invalid(
+                        "shape",
+                        "at least one non-zero component expected",
+                    ));
+                }
+            }
+        }
+        Ok(Self {
+            frequency_hz,
+            damping_ratio,
+            shape,
+        })
+    }
+
+    /// Natural frequency in Hz.
+    pub fn frequency_hz(&self) -> f64 {
+        self.frequency_hz
+    }
+    /// Natural frequency omega_n in rad/s.
+    pub fn omega_rad_s(&self) -> f64 {
+        2.0 * PI * self.frequency_hz
+    }
+    /// Damping ratio zeta_n.
+    pub fn damping_ratio(&self) -> f64 {
+        self.damping_ratio
+    }
+    /// How the shape was given.
+    pub fn shape(&self) -> ModeShape {
+        self.shape
+    }
+
+    /// Mass-normalized shape phi_n over the two coordinates (1/sqrt(kg)).
+    pub fn mass_normalized_shape(&self) -> [f64; 2] {
+        match self.shape {
+            ModeShape::MassNormalized(phi) => phi,
+            ModeShape::Directional {
+                coordinate,
+                stiffness_n_per_m,
+            } => {
+                let mut phi = [0.0; 2];
+                phi[coordinate] = self.omega_rad_s() / stiffness_n_per_m.sqrt();
+                phi
+            }
+        }
+    }
+
+    /// Modal stiffness seen at a coordinate, omega_n^2 / phi^2 (N/m); infinite when the mode does
+    /// not move there.
+    pub fn stiffness_at(&self, coordinate: usize) -> f64 {
+        let phi = self.mass_normalized_shape()[coordinate];
+        self.omega_rad_s().powi(2) / (phi * phi)
+    }
+
+    pub(crate) fn with_values(
+        self,
+        frequency_hz: f64,
+        damping_ratio: f64,
+        shape: ModeShape,
+    ) -> Self {
+        Self {
+            frequency_hz,
+            damping_ratio,
+            shape,
+        }
+    }
+}
+
+/// Linear specific cutting-force coefficients in SI (N/m^2).
+///
+/// Milling: tangential `kt` and normal `kn`. Turning: `kt` is the cutting (tangential) coefficient
+/// k_tc and `kn` the feed coefficient k_fc of 000 Eq. 3.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CuttingCoefficients {
+    kt_n_per_m2: f64,
+    kn_n_per_m2: f64,
+}
+
+impl CuttingCoefficients {
+    /// From kt and kn in N/m^2 (kt > 0, kn finite).
+    pub fn new(kt_n_per_m2: f64, kn_n_per_m2: f64) -> Result<Self> {
+        positive("cutting.kt_n_per_mm2", kt_n_per_m2)?;
+        finite("cutting.kn_n_per_mm2", kn_n_per_m2)?;
+        Ok(Self {
+            kt_n_per_m2,
+            kn_n_per_m2,
+        })
+    }
+
+    /// From the resultant ks (N/m^2) and its angle beta: kt = ks sin(beta), kn = ks cos(beta).
+    pub fn from_ks_beta(ks_n_per_m2: f64, beta_rad: f64) -> Result<Self> {
+        positive("cutting.ks_n_per_mm2", ks_n_per_m2)?;
+        finite("cutting.beta_deg", beta_rad)?;
+        Self::new(ks_n_per_m2 * beta_rad.sin(), ks_n_per_m2 * beta_rad.cos())
+    }
+
+    /// Tangential (cutting) coefficient in N/m^2.
+    pub fn kt_n_per_m2(&self) -> f64 {
+        self.kt_n_per_m2
+    }
+    /// Normal (milling) or feed (turning) coefficient in N/m^2.
+    pub fn kn_n_per_m2(&self) -> f64 {
+        self.kn_n_per_m2
+    }
+}
+
+/// A complete machine model: operation, cutting coefficients, modes and optional process damping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModalModel {
+    name: Option<String>,
+    operation: Operation,
+    cutting: CuttingCoefficients,
+    modes: Vec<Mode>,
+    process_damping_n_per_m: Option<f64>,
+}
+
+impl ModalModel {
+    /// A validated model with at least one mode.
+    pub fn new(
+        name: Option<String>,
+        operation: Operation,
+        cutting: CuttingCoefficients,
+        modes: Vec<Mode>,
+        process_damping_n_per_m: Option<f64>,
+    ) -> Result<Self> {
+        if modes.is_empty() {
+            return Err(DynamicsError::invalid(
+                "modes",
+                "at least one mode expected",
+            ));
+        }
+        if let Some(c) = process_damping_n_per_m {
+            non_negative("process_damping.c_n_per_m", c)?;
+            if operation.cutting_diameter_m().is_none() {
+                return Err(DynamicsError::invalid(
+                    "process_damping",
+                    "needs the cutting speed: give operation.tool_diameter_mm (milling) or \
+                     operation.workpiece_diameter_mm (turning)",
+                ));
+            }
+        }
+        Ok(Self {
+            name,
+            operation,
+            cutting,
+            modes,
+            process_damping_n_per_m,
+        })
+    }
+
+    /// Free-text name (which paper table the model comes from, for the examples).
+    pub fn name(&self) -> Option<&str> {
+        self.name.as_deref()
+    }
+    /// The operation.
+    pub fn operation(&self) -> &Operation {
+        &self.operation
+    }
+    /// The cutting coefficients.
+    pub fn cutting(&self) -> CuttingCoefficients {
+        self.cutting
+    }
+    /// The modes.
+    pub fn modes(&self) -> &[Mode] {
+        &self.modes
+    }
+    /// Process-damping coefficient C (N/m) in F_d = -C b ydot / V (003 Eq. 1), if any.
+    pub fn process_damping_n_per_m(&self) -> Option<f64> {
+        self.process_damping_n_per_m
+    }
+
+    /// The same model with another operation (e.g. a per-cut radial immersion).
+    pub fn with_operation(&self, operation: Operation) -> Result<Self> {
+        Self::new(
+            self.name.clone(),
+            operation,
+            self.cutting,
+            self.modes.clone(),
+            self.process_damping_n_per_m,
+        )
+    }
+    /// The same model with other cutting coefficients.
+    pub fn with_cutting(&self, cutting: CuttingCoefficients) -> Self {
+        Self {
+            cutting,
+            ..self.clone()
+        }
+    }
+    /// The same model with other modes (at least one).
+    pub fn with_modes(&self, modes: Vec<Mode>) -> Result<Self> {
+        Self::new(
+            self.name.clone(),
+            self.operation.clone(),
+            self.cutting,
+            modes,
+            self.process_damping_n_per_m,
+        )
+    }
+    /// The same model with another process-damping coefficient.
+    pub fn with_process_damping(&self, c_n_per_m: Option<f64>) -> Result<Self> {
+        Self::new(
+            self.name.clone(),
+            self.operation.clone(),
+            self.cutting,
+            self.modes.clone(),
+            c_n_per_m,
+        )
+    }
+    /// The same model renamed.
+    pub fn with_name(&self, name: Option<String>) -> Self {
+        Self {
+            name,
+            ..self.clone()
+        }
+    }
+
+    /// Number of modes N.
+    pub fn mode_count(&self) -> usize {
+        self.modes.len()
+    }
+    /// Natural frequencies omega_n (rad/s).
+    pub fn omegas_rad_s(&self) -> Vec<f64> {
+        self.modes.iter().map(Mode::omega_rad_s).collect()
+    }
+    /// Damping ratios zeta_n.
+    pub fn damping_ratios(&self) -> Vec<f64> {
+        self.modes.iter().map(Mode::damping_ratio).collect()
+    }
+    /// Mass-normalized shape matrix Phi (2 x N, 000 Eq. 1) as rows per coordinate.
+    pub fn shape_matrix(&self) -> nalgebra::DMatrix<f64> {
+        let n = self.modes.len();
+        nalgebra::DMatrix::from_fn(2, n, |i, j| self.modes[j].mass_normalized_shape()[i])
+    }
+}

@@ -1,0 +1,391 @@
+//! The machine-model file of `shared/spec/formats.md`: JSON with units in every field name.
+//! Unknown fields are rejected so a typo never passes silently; every error names the file, the
+//! field and what was expected.
+
+use crate::error::{DynamicsError, Result};
+use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
+use crate::operation::{Milling, MillingDirection, Operation, Turning};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Model file as written by users (formats spec, "Machine model").
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Free text.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Operation.
+    pub operation: OperationFile,
+    /// Cutting coefficients.
+    pub cutting: CuttingFile,
+    /// Structural modes.
+    pub modes: Vec<ModeFile>,
+    /// Optional process damping.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub process_damping: Option<ProcessDampingFile>,
+}
+
+/// `operation` object.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OperationFile {
+    /// `"milling"` or `"turning"`.
+    pub kind: String,
+    /// Milling: number of teeth.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub teeth: Option<i64>,
+    /// Milling: radial immersion a/D.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial_immersion: Option<f64>,
+    /// Milling: `"up"` or `"down"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<String>,
+    /// Milling: tool diameter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_diameter_mm: Option<f64>,
+    /// Milling: helix angle (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub helix_deg: Option<f64>,
+    /// Turning: workpiece diameter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub workpiece_diameter_mm: Option<f64>,
+}
+
+/// `cutting` object: kt/kn or ks/beta.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CuttingFile {
+    /// Tangential coefficient.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kt_n_per_mm2: Option<f64>,
+    /// Normal (milling) or feed (turning) coefficient.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kn_n_per_mm2: Option<f64>,
+    /// Resultant coefficient.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ks_n_per_mm2: Option<f64>,
+    /// Force angle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_deg: Option<f64>,
+}
+
+/// One entry of `modes`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModeFile {
+    /// Natural frequency.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+    /// Stiffness (with `direction`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness_n_per_m: Option<f64>,
+    /// Coordinate name (with `stiffness_n_per_m`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<String>,
+    /// Mass-normalized shape over coordinate names, 1/sqrt(kg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<BTreeMap<String, f64>>,
+}
+
+/// `process_damping` object.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ProcessDampingFile {
+    /// Coefficient C in F_d = -C b ydot / V.
+    pub c_n_per_m: f64,
+}
+
+fn opt_f(field: &str, v: Option<f64>) -> Result<Option<f64>> {
+    match v {
+        Some(x) if !x.is_finite() => Err(DynamicsError::value(field, x, "a finite number")),
+        other => Ok(other),
+    }
+}
+
+impl OperationFile {
+    fn validate(&self) -> Result<Operation> {
+        match self.kind.as_str() {
+            "milling" => {
+                if self.workpiece_diameter_mm.is_some() {
+                    return Err(DynamicsError::invalid(
+                        "operation.workpiece_diameter_mm",
+                        "only for turning; milling uses tool_diameter_mm",
+                    ));
+                }
+                let teeth = self.teeth.ok_or_else(|| {
+                    DynamicsError::invalid(
+                        "operation.teeth",
+                        "missing: milling needs the number of teeth",
+                    )
+                })?;
+                if teeth < 1 {
+                    return Err(DynamicsError::value(
+                        "operation.teeth",
+                        teeth as f64,
+                        "an integer >= 1",
+                    ));
+                }
+                let r = self.radial_immersion.ok_or_else(|| {
+                    DynamicsError::invalid(
+                        "operation.radial_immersion",
+                        "missing: milling needs the radial immersion a/D in (0, 1]",
+                    )
+                })?;
+                let direction = match self.direction.as_deref() {
+                    Some("up") => MillingDirection::Up,
+                    Some("down") => MillingDirection::Down,
+                    Some(other) => {
+                        return Err(DynamicsError::invalid(
+                            "operation.direction",
+                            format!("`{other}`: expected \"up\" or \"down\""),
+                        ));
+                    }
+                    None => {
+                        return Err(DynamicsError::invalid(
+                            "operation.direction",
+                            "missing: expected \"up\" or \"down\"",
+                        ));
+                    }
+                };
+                let d = opt_f("operation.tool_diameter_mm", self.tool_diameter_mm)?;
+                let h = opt_f("operation.helix_deg", self.helix_deg)?;
+                Ok(Operation::Milling(Milling::new(
+                    teeth as usize,
+                    r,
+                    direction,
+                    d.map(|d| d * 1e-3),
+                    h.map(f64::to_radians),
+                )?))
+            }
+            "turning" => {
+                for (set, name) in [
+                    (self.teeth.is_some(), "teeth"),
+                    (self.radial_immersion.is_some(), "radial_immersion"),
+                    (self.direction.is_some(), "direction"),
+                    (self.tool_diameter_mm.is_some(), "tool_diameter_mm"),
+                    (self.helix_deg.is_some(), "helix_deg"),
+                ] {
+                    if set {
+                        return Err(DynamicsError::invalid(
+                            format!("operation.{name}"),
+                            "only for milling",
+                        ));
+                    }
+                }
+                let d = opt_f(
+                    "operation.workpiece_diameter_mm",
+                    self.workpiece_diameter_mm,
+                )?;
+                Ok(Operation::Turning(Turning::new(d.map(|d| d * 1e-3))?))
+            }
+            other => Err(DynamicsError::invalid(
+                "operation.kind",
+                format!("`{other}`: expected \"milling\" or \"turning\""),
+            )),
+        }
+    }
+}
+
+impl CuttingFile {
+    fn validate(&self) -> Result<CuttingCoefficients> {
+        match (
+            self.kt_n_per_mm2,
+            self.kn_n_per_mm2,
+            self.ks_n_per_mm2,
+            self.beta_deg,
+        ) {
+            (Some(kt), Some(kn), None, None) => CuttingCoefficients::new(kt * 1e6, kn * 1e6),
+            (None, None, Some(ks), Some(beta)) => {
+                CuttingCoefficients::from_ks_beta(ks * 1e6, beta.to_radians())
+            }
+            _ => Err(DynamicsError::invalid(
+                "cutting",
+                "expected either kt_n_per_mm2 and kn_n_per_mm2, or ks_n_per_mm2 and beta_deg",
+            )),
+        }
+    }
+}
+
+impl ModeFile {
+    fn validate(&self, index: usize, operation: &Operation) -> Result<Mode> {
+        let field = |f: &str| format!("modes[{index}].{f}");
+        let coordinate = |name: &str, f: &str| {
+            operation.coordinate_index(name).ok_or_else(|| {
+                let names: Vec<_> = operation.coordinates().iter().map(|c| c.name()).collect();
+                DynamicsError::invalid(
+                    field(f),
+                    format!(
+                        "`{name}` is not a coordinate of this operation; expected one of {names:?}"
+                    ),
+                )
+            })
+        };
+        let shape = match (&self.direction, self.stiffness_n_per_m, &self.shape) {
+            (Some(dir), Some(k), None) => ModeShape::Directional {
+                coordinate: coordinate(dir, "direction")?,
+                stiffness_n_per_m: k,
+            },
+            (None, None, Some(map)) => {
+                let mut phi = [0.0; 2];
+                for (name, &v) in map {
+                    phi[coordinate(name, "shape")?] = v;
+                }
+                ModeShape::MassNormalized(phi)
+            }
+            _ => {
+                return Err(DynamicsError::invalid(
+                    field("shape"),
+                    "expected either `direction` with `stiffness_n_per_m`, or `shape`",
+                ));
+            }
+        };
+        Mode::new(self.frequency_hz, self.damping_ratio, shape).map_err(|e| match e {
+            DynamicsError::InvalidValue {
+                field: f,
+                value,
+                expected,
+            } => DynamicsError::InvalidValue {
+                field: field(&f),
+                value,
+                expected,
+            },
+            DynamicsError::Invalid { field: f, message } => DynamicsError::Invalid {
+                field: field(&f),
+                message,
+            },
+            other => other,
+        })
+    }
+}
+
+impl ModelFile {
+    /// Validate into a [`ModalModel`] (SI units inside).
+    pub fn validate(&self) -> Result<ModalModel> {
+        let operation = self.operation.validate()?;
+        let cutting = self.cutting.validate()?;
+        let modes = self
+            .modes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| m.validate(i, &operation))
+            .collect::<Result<Vec<_>>>()?;
+        let c = self.process_damping.as_ref().map(|p| p.c_n_per_m);
+        ModalModel::new(self.name.clone(), operation, cutting, modes, c)
+    }
+
+    /// The file form of a model (inverse of [`ModelFile::validate`]).
+    pub fn from_model(model: &ModalModel) -> Self {
+        let coords = model.operation().coordinates();
+        let operation = match model.operation() {
+            Operation::Milling(m) => OperationFile {
+                kind: "milling".into(),
+                teeth: Some(m.teeth() as i64),
+                radial_immersion: Some(m.radial_immersion()),
+                direction: Some(
+                    match m.direction() {
+                        MillingDirection::Up => "up",
+                        MillingDirection::Down => "down",
+                    }
+                    .into(),
+                ),
+                tool_diameter_mm: m.tool_diameter_m().map(|d| d * 1e3),
+                helix_deg: m.helix_rad().map(f64::to_degrees),
+                workpiece_diameter_mm: None,
+            },
+            Operation::Turning(t) => OperationFile {
+                kind: "turning".into(),
+                teeth: None,
+                radial_immersion: None,
+                direction: None,
+                tool_diameter_mm: None,
+                helix_deg: None,
+                workpiece_diameter_mm: t.workpiece_diameter_m().map(|d| d * 1e3),
+            },
+        };
+        let modes = model
+            .modes()
+            .iter()
+            .map(|m| {
+                let (stiffness_n_per_m, direction, shape) = match m.shape() {
+                    ModeShape::Directional {
+                        coordinate,
+                        stiffness_n_per_m,
+                    } => (
+                        Some(stiffness_n_per_m),
+                        Some(coords[coordinate].name().to_string()),
+                        None,
+                    ),
+                    ModeShape::MassNormalized(phi) => (
+                        None,
+                        None,
+                        Some(
+                            coords
+                                .iter()
+                                .zip(phi)
+                                .map(|(c, v)| (c.name().to_string(), v))
+                                .collect(),
+                        ),
+                    ),
+                };
+                ModeFile {
+                    frequency_hz: m.frequency_hz(),
+                    damping_ratio: m.damping_ratio(),
+                    stiffness_n_per_m,
+                    direction,
+                    shape,
+                }
+            })
+            .collect();
+        let cutting = model.cutting();
+        ModelFile {
+            name: model.name().map(str::to_string),
+            operation,
+            cutting: CuttingFile {
+                kt_n_per_mm2: Some(cutting.kt_n_per_m2() * 1e-6),
+                kn_n_per_mm2: Some(cutting.kn_n_per_m2() * 1e-6),
+                ks_n_per_mm2: None,
+                beta_deg: None,
+            },
+            modes,
+            process_damping: model
+                .process_damping_n_per_m()
+                .map(|c| ProcessDampingFile { c_n_per_m: c }),
+        }
+    }
+}
+
+impl ModalModel {
+    /// Parse and validate a model from JSON text; `origin` names the source in errors.
+    pub fn from_json_str(text: &str, origin: &Path) -> Result<Self> {
+        if text.trim().is_empty() {
+            return Err(DynamicsError::Parse {
+                path: origin.to_path_buf(),
+                message: "empty file: expected a JSON model object".into(),
+            });
+        }
+        let file: ModelFile = serde_json::from_str(text).map_err(|e| DynamicsError::Parse {
+            path: origin.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        file.validate().map_err(|e| e.in_file(origin))
+    }
+
+    /// Read and validate a model file.
+    pub fn from_path(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| DynamicsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json_str(&text, path)
+    }
+
+    /// Pretty JSON in the formats-spec shape.
+    pub fn to_json_string(&self) -> String {
+        serde_json::to_string_pretty(&ModelFile::from_model(self))
+            .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+}

@@ -1,0 +1,1 @@
+//! chatter-oma (under construction)

@@ -1,0 +1,1 @@
+//! chatter-stability (under construction)

@@ -1,0 +1,1 @@
+//! chatter-uncertainty (under construction)
