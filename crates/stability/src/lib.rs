@@ -1,1 +1,33 @@
-//! chatter-stability (under construction)
+//! Chatter stability of turning and milling (seeds 000, 001, 002, 003).
+//!
+//! Every method maps a cutting condition (spindle speed, depth) to the dominant multiplier of the
+//! regenerative delay equation M x'' + C x' + K x = -b H(t) (x(t) - x(t - tau)) (000 Eq. 4,
+//! 002 Eq. 1); the cut is stable when |mu| < 1. Solvers implement [`StabilitySolver`], so lobe
+//! diagrams, uncertainty bands and likelihoods work with any of them.
+
+#![cfg_attr(test, allow(clippy::unwrap_used))]
+
+pub mod error;
+pub mod multiplier;
+
+pub use error::{Result, StabilityError};
+pub use multiplier::{DominantMultiplier, MultiplierKind};
+
+use chatter_dynamics::ModalModel;
+
+/// A stability method: the dominant multiplier at one cutting condition.
+///
+/// Implementations must be thread-safe and deterministic, because lobe diagrams evaluate them in
+/// parallel over speeds and samplers call them thousands of times.
+pub trait StabilitySolver: Sync {
+    /// Short name (`"zoa"`, `"fdm"`, `"sdm"`, `"frequency-domain"`).
+    fn name(&self) -> &'static str;
+
+    /// Dominant multiplier over one delay at `speed_rpm` and depth (width) `depth_m`.
+    fn dominant_multiplier(
+        &self,
+        model: &ModalModel,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<DominantMultiplier>;
+}
