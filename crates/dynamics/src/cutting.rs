@@ -130,3 +130,72 @@ impl ModalModel {
 fn turning_matrix(cutting: CuttingCoefficients) -> Matrix2<f64> {
     Matrix2::new(cutting.kn_n_per_m2(), 0.0, cutting.kt_n_per_m2(), 0.0)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::examples;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn average_matrix_equals_numerical_time_average() {
+        // 001 example (20 % down milling) and the benchmark at full and 5 % immersion.
+        for model in [
+            examples::schmitz_2023_milling(),
+            examples::insperger_benchmark(1.0),
+            examples::insperger_benchmark(0.05),
+        ] {
+            let rpm = 6000.0;
+            let tau = model.operation().delay_s(rpm);
+            let n = 200_000;
+            let mut avg = nalgebra::Matrix2::zeros();
+            for k in 0..n {
+                let t = (k as f64 + 0.5) / n as f64 * tau;
+                avg += model.directional_matrix(t, rpm);
+            }
+            avg /= n as f64;
+            let exact = model.average_directional_matrix();
+            let scale = exact.abs().max();
+            // midpoint rule over a discontinuous integrand: error O(1/n) of the scale
+            assert!(
+                (avg - exact).abs().max() < 1e-4 * scale,
+                "{:?}: numeric {avg} vs exact {exact}",
+                model.name()
+            );
+        }
+    }
+
+    #[test]
+    fn full_immersion_average_is_classic_result() {
+        // Slotting: A0 = N/(4 pi) [[0, pi kt], [-pi kt, 0]]... with kn: N/(2 pi) * pi/2 [[kn, kt], [-kt, kn]]
+        let model = examples::insperger_benchmark(1.0);
+        let a = model.average_directional_matrix();
+        let (kt, kn) = (6e8, 2e8);
+        let f = 2.0 / (2.0 * PI) * PI / 2.0;
+        assert!((a[(0, 0)] - f * kn).abs() < 1e-6 * kt);
+        assert!((a[(0, 1)] - f * kt).abs() < 1e-6 * kt);
+        assert!((a[(1, 0)] + f * kt).abs() < 1e-6 * kt);
+        assert!((a[(1, 1)] - f * kn).abs() < 1e-6 * kt);
+    }
+
+    #[test]
+    fn turning_matrix_is_kc() {
+        let model = examples::ahmadi_2022_turning();
+        let h = model.directional_matrix(0.3, 7000.0);
+        assert_eq!(h[(0, 0)], 159e6);
+        assert_eq!(h[(1, 0)], 635e6);
+        assert_eq!(h[(0, 1)], 0.0);
+        assert_eq!(h[(1, 1)], 0.0);
+    }
+
+    #[test]
+    fn process_damping_turning_acts_on_feed() {
+        let model = examples::ahmadi_2022_turning()
+            .with_process_damping(Some(2.0e5))
+            .unwrap();
+        let rpm = 6000.0;
+        let v = PI * 0.038 * rpm / 60.0;
+        let d = model.process_damping_matrix(0.0, rpm);
+        assert!((d[(0, 0)] - 2.0e5 / v).abs() < 1e-9 * d[(0, 0)]);
+        assert_eq!(d[(1, 1)], 0.0);
+    }
+}

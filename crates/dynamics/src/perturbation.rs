@@ -159,3 +159,67 @@ pub fn parse_parameters(list: &str) -> Result<Vec<Parameter>> {
         .map(str::parse)
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::examples;
+
+    #[test]
+    fn names_round_trip() {
+        for name in ["theta_omega_1", "theta_zeta_2", "theta_phi_3", "theta_k_10"] {
+            let p: Parameter = name.parse().unwrap();
+            assert_eq!(p.to_string(), name);
+        }
+        for bad in ["theta_omega_0", "omega_1", "theta_x_1", "theta_k_", "theta_k_a"] {
+            assert!(bad.parse::<Parameter>().is_err(), "{bad} accepted");
+        }
+    }
+
+    #[test]
+    fn stiffness_and_shape_scalings_agree() {
+        // k (1 + theta_k) is phi / sqrt(1 + theta_k): the same model as theta_phi = 1/sqrt(1+t) - 1
+        let model = examples::ebrahimi_2025_milling();
+        let t = 0.21;
+        let by_k = model
+            .perturbed(&[Parameter::new(ParameterKind::Stiffness, 0)], &[t])
+            .unwrap();
+        let by_phi = model
+            .perturbed(
+                &[Parameter::new(ParameterKind::Phi, 0)],
+                &[1.0 / (1.0_f64 + t).sqrt() - 1.0],
+            )
+            .unwrap();
+        let (a, b) = (by_k.modes()[0].stiffness_at(0), by_phi.modes()[0].stiffness_at(0));
+        assert!((a - b).abs() < 1e-9 * a);
+        assert!((a - 2.34e6 * (1.0 + t)).abs() < 1e-6 * a);
+    }
+
+    #[test]
+    fn omega_keeps_shape_for_mass_normalized_and_stiffness_for_directional() {
+        let turning = examples::ahmadi_2022_turning();
+        let p = [Parameter::new(ParameterKind::Omega, 1)];
+        let t = turning.perturbed(&p, &[0.01]).unwrap();
+        assert_eq!(
+            t.modes()[1].mass_normalized_shape(),
+            turning.modes()[1].mass_normalized_shape()
+        );
+        let milling = examples::ebrahimi_2025_milling();
+        let m = milling
+            .perturbed(&[Parameter::new(ParameterKind::Omega, 0)], &[0.01])
+            .unwrap();
+        assert!((m.modes()[0].stiffness_at(0) - 2.34e6).abs() < 1e-6);
+    }
+
+    #[test]
+    fn invalid_perturbations_are_errors() {
+        let model = examples::ahmadi_2022_turning();
+        let p = Parameter::new(ParameterKind::Zeta, 5);
+        assert!(model.perturbed(&[p], &[0.1]).is_err());
+        let p = Parameter::new(ParameterKind::Omega, 0);
+        assert!(model.perturbed(&[p], &[-1.5]).is_err());
+        assert!(model.perturbed(&[p], &[0.1, 0.2]).is_err());
+        let z = Parameter::new(ParameterKind::Zeta, 0);
+        assert!(model.perturbed(&[z], &[100.0]).is_err());
+    }
+}
