@@ -2,10 +2,13 @@
 //!
 //! - [`geometric`]: Type B offset boundaries from user-stated offsets in speed and depth
 //!   (Schmitz 2023, seed 001, Eq. 1-11).
+//! - [`perturbation`]: second-order perturbation mean and variance of the dominant eigenvalue and
+//!   the credibility-bounded lobes (Ahmadi 2022, seed 000, Eq. 14-18).
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod error;
 pub mod geometric;
+pub mod perturbation;
 
 pub use error::{Result, UncertaintyError};
