@@ -7,7 +7,9 @@
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
+pub mod boundary;
 pub mod error;
+pub mod monodromy;
 pub mod multiplier;
 
 pub use error::{Result, StabilityError};

@@ -80,7 +80,11 @@ impl DominantMultiplier {
         let k = (reference_hz / ft).floor() as i32;
         self.frequency_family_hz((k - 1)..=(k + 2))
             .into_iter()
-            .min_by(|a, b| (a - reference_hz).abs().total_cmp(&(b - reference_hz).abs()))
+            .min_by(|a, b| {
+                (a - reference_hz)
+                    .abs()
+                    .total_cmp(&(b - reference_hz).abs())
+            })
             .unwrap_or(self.principal_frequency_hz())
     }
 }
