@@ -171,7 +171,13 @@ mod tests {
             let p: Parameter = name.parse().unwrap();
             assert_eq!(p.to_string(), name);
         }
-        for bad in ["theta_omega_0", "omega_1", "theta_x_1", "theta_k_", "theta_k_a"] {
+        for bad in [
+            "theta_omega_0",
+            "omega_1",
+            "theta_x_1",
+            "theta_k_",
+            "theta_k_a",
+        ] {
             assert!(bad.parse::<Parameter>().is_err(), "{bad} accepted");
         }
     }
@@ -190,7 +196,10 @@ mod tests {
                 &[1.0 / (1.0_f64 + t).sqrt() - 1.0],
             )
             .unwrap();
-        let (a, b) = (by_k.modes()[0].stiffness_at(0), by_phi.modes()[0].stiffness_at(0));
+        let (a, b) = (
+            by_k.modes()[0].stiffness_at(0),
+            by_phi.modes()[0].stiffness_at(0),
+        );
         assert!((a - b).abs() < 1e-9 * a);
         assert!((a - 2.34e6 * (1.0 + t)).abs() < 1e-6 * a);
     }

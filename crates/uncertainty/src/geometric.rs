@@ -263,12 +263,7 @@ fn remove_loops(mut p: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
 }
 
 /// Proper intersection point of segments ab and cd.
-fn intersection(
-    a: (f64, f64),
-    b: (f64, f64),
-    c: (f64, f64),
-    d: (f64, f64),
-) -> Option<(f64, f64)> {
+fn intersection(a: (f64, f64), b: (f64, f64), c: (f64, f64), d: (f64, f64)) -> Option<(f64, f64)> {
     let r = (b.0 - a.0, b.1 - a.1);
     let s = (d.0 - c.0, d.1 - c.1);
     let den = r.0 * s.1 - r.1 * s.0;

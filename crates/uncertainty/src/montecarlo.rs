@@ -58,7 +58,10 @@ impl SampledBoundaries {
             });
         }
         let n = speeds_rpm.len();
-        if limits_mm.iter().chain(&chatter_hz).any(|row| row.len() != n)
+        if limits_mm
+            .iter()
+            .chain(&chatter_hz)
+            .any(|row| row.len() != n)
             || chatter_hz.len() != limits_mm.len()
         {
             return Err(UncertaintyError::InvalidInput {

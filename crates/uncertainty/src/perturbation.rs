@@ -204,8 +204,16 @@ mod tests {
         let mean: Complex64 = samples.iter().sum::<Complex64>() / n as f64;
         let var: f64 = samples.iter().map(|z| (z - mean).norm_sqr()).sum::<f64>() / n as f64;
         // Monte Carlo standard errors at n = 4e5 are ~1e-3 relative; tolerance 1 %.
-        assert!((mean - m.mean).norm() < 0.01 * m.mean.norm(), "{mean} vs {}", m.mean);
-        assert!((var - m.variance).abs() < 0.01 * m.variance, "{var} vs {}", m.variance);
+        assert!(
+            (mean - m.mean).norm() < 0.01 * m.mean.norm(),
+            "{mean} vs {}",
+            m.mean
+        );
+        assert!(
+            (var - m.variance).abs() < 0.01 * m.variance,
+            "{var} vs {}",
+            m.variance
+        );
     }
 
     #[test]
@@ -225,7 +233,11 @@ mod tests {
             let sigma = DMatrix::from_element(1, 1, s2);
             let grid = MomentGrid::evaluate(&speeds, &depths, &sigma, sens).unwrap();
             let p = grid.bounds()[0];
-            let (lo, mid, up) = (p.lower_mm.unwrap(), p.depth_mm.unwrap(), p.upper_mm.unwrap());
+            let (lo, mid, up) = (
+                p.lower_mm.unwrap(),
+                p.depth_mm.unwrap(),
+                p.upper_mm.unwrap(),
+            );
             assert!((mid - 2.0).abs() < 1e-9);
             // |mu| (1 +- s) = 1 -> b = 2 / (1 +- s)
             let s = s2.sqrt();

@@ -31,7 +31,12 @@ pub struct ObservedPole {
 
 impl ObservedPole {
     /// The pole of frequency f (Hz) and damping ratio zeta (000 Eq. 25 inverted).
-    pub fn from_frequency_damping(speed_rpm: f64, depth_m: f64, frequency_hz: f64, zeta: f64) -> Self {
+    pub fn from_frequency_damping(
+        speed_rpm: f64,
+        depth_m: f64,
+        frequency_hz: f64,
+        zeta: f64,
+    ) -> Self {
         let w = 2.0 * PI * frequency_hz;
         Self {
             speed_rpm,
@@ -50,7 +55,10 @@ pub fn expand_repetitions(poles: &[PoleObservation]) -> Vec<ObservedPole> {
     let mut out = Vec::new();
     for p in poles {
         let n = p.repetitions.unwrap_or(1).max(1) as usize;
-        let (sf, sz) = (p.frequency_std_hz.unwrap_or(0.0), p.damping_std.unwrap_or(0.0));
+        let (sf, sz) = (
+            p.frequency_std_hz.unwrap_or(0.0),
+            p.damping_std.unwrap_or(0.0),
+        );
         let depth_m = p.depth_mm * 1e-3;
         if n == 1 || (sf == 0.0 && sz == 0.0) {
             out.push(ObservedPole::from_frequency_damping(
@@ -243,10 +251,7 @@ impl TurningPoleLikelihood {
         };
         let var_i = self.alpha * var_r;
         let n = res.len() as f64;
-        let chi2: f64 = res
-            .iter()
-            .map(|(r, i)| r * r / var_r + i * i / var_i)
-            .sum();
+        let chi2: f64 = res.iter().map(|(r, i)| r * r / var_r + i * i / var_i).sum();
         -0.5 * chi2 - n * (2.0 * PI * (var_r * var_i).sqrt()).ln()
     }
 }
