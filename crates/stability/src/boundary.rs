@@ -174,11 +174,11 @@ pub fn limiting_depth<S: StabilitySolver + ?Sized>(
         }
     }
     let depth_m = 0.5 * (lo + hi);
-    let mu = solver.dominant_multiplier(model, speed_rpm, depth_m)?;
+    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
     Ok(LobePoint {
         speed_rpm,
         depth_m,
-        chatter_hz: mu.chatter_frequency_near_hz(dominant_mode_frequency_hz(model)),
+        chatter_hz,
     })
 }
 

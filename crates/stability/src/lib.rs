@@ -11,6 +11,7 @@ pub mod boundary;
 pub mod error;
 pub mod monodromy;
 pub mod multiplier;
+pub mod zero_order;
 
 pub use error::{Result, StabilityError};
 pub use multiplier::{DominantMultiplier, MultiplierKind};
@@ -32,4 +33,18 @@ pub trait StabilitySolver: Sync {
         speed_rpm: f64,
         depth_m: f64,
     ) -> Result<DominantMultiplier>;
+
+    /// The dominant multiplier with the chatter frequency (Hz) it implies. The default picks the
+    /// member of the family f_mu + k / tau closest to the mode that dominates the cut; solvers
+    /// that know the eigenvector resolve the family exactly.
+    fn chatter_frequency_hz(
+        &self,
+        model: &ModalModel,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        let mu = self.dominant_multiplier(model, speed_rpm, depth_m)?;
+        let f = mu.chatter_frequency_near_hz(boundary::dominant_mode_frequency_hz(model));
+        Ok((mu, f))
+    }
 }

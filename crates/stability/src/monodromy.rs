@@ -120,6 +120,29 @@ impl StabilitySolver for Discretization {
             op.period_s,
         ))
     }
+
+    fn chatter_frequency_hz(
+        &self,
+        model: &ModalModel,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        let op = self.monodromy(model, speed_rpm, depth_m)?;
+        let (mu, vector) = op.dominant_eigenpair()?;
+        let mu = DominantMultiplier::new(mu, op.period_s);
+        let (lo, hi) = model
+            .modes()
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
+                (lo.min(m.frequency_hz()), hi.max(m.frequency_hz()))
+            });
+        let f = op
+            .eigenvector_frequency_hz(&vector, &mu, (0.5 * lo, 2.0 * hi))
+            .unwrap_or_else(|| {
+                mu.chatter_frequency_near_hz(crate::boundary::dominant_mode_frequency_hz(model))
+            });
+        Ok((mu, f))
+    }
 }
 
 /// One step of the program: y_{k+1} = P y_k + R q_a + S q_b where q_a, q_b are delayed grid
@@ -143,6 +166,8 @@ pub struct Monodromy {
     /// Grid points per delay M.
     grid: usize,
     steps: Vec<Step>,
+    /// Length (s) of the step leaving each grid point.
+    step_s: Vec<f64>,
     /// The delay tau (s).
     pub period_s: f64,
 }
@@ -254,6 +279,7 @@ impl Monodromy {
             (a, b)
         };
         let mut steps = Vec::new();
+        let mut step_s = Vec::new();
         let mut grid = 0usize;
         for &(start, end, cutting) in &segs {
             let len = end - start;
@@ -265,6 +291,7 @@ impl Monodromy {
                     start: grid,
                     cutting: false,
                 });
+                step_s.push(len);
                 grid += 1;
                 continue;
             }
@@ -334,6 +361,7 @@ impl Monodromy {
                     }
                 };
                 steps.push(step);
+                step_s.push(h);
                 grid += 1;
             }
         }
@@ -341,6 +369,7 @@ impl Monodromy {
             modes: n,
             grid,
             steps,
+            step_s,
             period_s: tau,
         })
     }
@@ -406,7 +435,76 @@ impl Monodromy {
         if d <= 24 {
             return largest(&self.dense().complex_eigenvalues());
         }
-        arnoldi_dominant(self, d)
+        Ok(arnoldi(self, d)?.0)
+    }
+}
+
+impl Monodromy {
+    /// The dominant eigenvalue and its (complex) eigenvector.
+    pub fn dominant_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
+        let d = self.dimension();
+        if d > 24 {
+            return arnoldi(self, d);
+        }
+        let dense = self.dense();
+        let mu = largest(&dense.complex_eigenvalues())?;
+        let shift = mu * Complex64::new(1.0 + 1e-10, 0.0);
+        let lu = (dense.map(|x| Complex64::new(x, 0.0)) - DMatrix::identity(d, d) * shift).lu();
+        let mut x = DVector::from_element(d, Complex64::new(1.0, 0.0));
+        for _ in 0..3 {
+            if let Some(s) = lu.solve(&x) {
+                let nrm = s.norm();
+                x = s / Complex64::new(nrm, 0.0);
+            }
+        }
+        Ok((mu, x.iter().copied().collect()))
+    }
+
+    /// Chatter frequency (Hz) of the dominant eigenfunction: among the family f_mu + k / tau
+    /// (within half the lowest to twice the highest natural frequency) the member with the largest
+    /// Fourier amplitude of the delayed displacements over one delay. `None` when the grid has
+    /// free flight (the eigenfunction is not sampled over the whole delay) or no candidate exists.
+    pub fn eigenvector_frequency_hz(
+        &self,
+        vector: &[Complex64],
+        multiplier: &DominantMultiplier,
+        band_hz: (f64, f64),
+    ) -> Option<f64> {
+        if self.steps.iter().any(|s| !s.cutting) {
+            return None;
+        }
+        let n = self.modes;
+        let s2 = 2 * n;
+        let ft = 1.0 / self.period_s;
+        let k_max = (band_hz.1 / ft).ceil() as i32 + 1;
+        let candidates = multiplier.frequency_family_hz(0..=k_max);
+        let mut times = Vec::with_capacity(self.grid);
+        let mut t = 0.0;
+        for &h in &self.step_s {
+            times.push(t);
+            t += h;
+        }
+        candidates
+            .into_iter()
+            .filter(|f| *f >= band_hz.0 && *f <= band_hz.1)
+            .map(|f| {
+                let amplitude: f64 = (0..n)
+                    .map(|j| {
+                        let sum: Complex64 = (0..self.grid)
+                            .map(|k| {
+                                let phase = -2.0 * PI * f * times[k];
+                                vector[s2 + k * n + j]
+                                    * Complex64::new(phase.cos(), phase.sin())
+                                    * self.step_s[k]
+                            })
+                            .sum();
+                        sum.norm_sqr()
+                    })
+                    .sum();
+                (f, amplitude)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|x| x.0)
     }
 }
 
@@ -429,13 +527,13 @@ const ARNOLDI_RESTARTS: usize = 40;
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
 const ARNOLDI_TOL: f64 = 1e-11;
 
-fn arnoldi_dominant(op: &Monodromy, d: usize) -> Result<Complex64> {
+fn arnoldi(op: &Monodromy, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
     let k = ARNOLDI_DIM.min(d - 1);
     // deterministic start vector
     let mut start: Vec<f64> = (0..d)
         .map(|i| 1.0 + 0.5 * ((i as f64) * 0.7).sin())
         .collect();
-    let mut previous: Option<Complex64> = None;
+    let mut previous: Option<(Complex64, Vec<Complex64>)> = None;
     let mut v = vec![vec![0.0; d]; k + 1];
     let mut w = vec![0.0; d];
     for _ in 0..ARNOLDI_RESTARTS {
@@ -485,20 +583,20 @@ fn arnoldi_dominant(op: &Monodromy, d: usize) -> Result<Complex64> {
         } else {
             0.0
         };
-        let converged_prev =
-            previous.is_some_and(|p| (p - theta).norm() <= 1e-3 * ARNOLDI_TOL * theta.norm());
+        let converged_prev = previous
+            .as_ref()
+            .is_some_and(|p| (p.0 - theta).norm() <= 1e-3 * ARNOLDI_TOL * theta.norm());
+        let ritz: Vec<Complex64> = (0..d)
+            .map(|i| (0..kk).map(|j| x[j] * v[j][i]).sum())
+            .collect();
         if residual <= ARNOLDI_TOL * theta.norm().max(1e-300) || converged_prev || kk < k {
-            return Ok(theta);
+            return Ok((theta, ritz));
         }
-        previous = Some(theta);
         // restart from the real and imaginary parts of the Ritz vector combined
-        for (i, s) in start.iter_mut().enumerate() {
-            let mut acc = Complex64::new(0.0, 0.0);
-            for j in 0..kk {
-                acc += x[j] * v[j][i];
-            }
-            *s = acc.re + acc.im;
+        for (s, r) in start.iter_mut().zip(&ritz) {
+            *s = r.re + r.im;
         }
+        previous = Some((theta, ritz));
     }
     previous.ok_or(StabilityError::NoConvergence {
         solver: "Arnoldi",
