@@ -40,13 +40,12 @@ pub enum DynamicsError {
         message: String,
     },
     /// A file parsed but its content is invalid.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     InFile {
         /// The file concerned.
         path: PathBuf,
         /// The validation error.
-        #[source]
-        source: Box<DynamicsError>,
+        error: Box<DynamicsError>,
     },
 }
 
@@ -72,7 +71,7 @@ impl DynamicsError {
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
         Self::InFile {
             path: path.into(),
-            source: Box::new(self),
+            error: Box::new(self),
         }
     }
 }

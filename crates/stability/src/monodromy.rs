@@ -305,8 +305,18 @@ impl Monodromy {
                     DMatrix::zeros(0, 0),
                 ),
             };
+            // constant coefficients (turning): every step of the segment is the same
+            let constant = matches!(model.operation(), Operation::Turning(_));
             for i in 0..k {
                 let t0 = start + i as f64 * h;
+                if constant && i > 0 {
+                    let mut step = steps[steps.len() - 1].clone();
+                    step.start = grid;
+                    steps.push(step);
+                    step_s.push(h);
+                    grid += 1;
+                    continue;
+                }
                 let step = match method.scheme {
                     Scheme::Full => {
                         // products interpolated just inside the segment (H is smooth there)

@@ -1,0 +1,429 @@
+//! One function per subcommand: parse inputs, call the libraries, write results.
+
+use crate::output::{emit, write_atomic};
+use crate::plot::{Markers, Series, line_chart};
+use crate::{inputs, progress::Bar};
+use anyhow::{Context, Result, bail};
+use chatter_dynamics::{ModalModel, Observations};
+use chatter_stability::StabilitySolver;
+use chatter_stability::boundary::{BoundaryOptions, LobePoint, lobe_diagram};
+use chatter_stability::monodromy::Discretization;
+use chatter_stability::zero_order::zoa_lobes;
+use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
+use plotters::style::{BLUE, GREEN, RGBColor};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Stability method names of the CLI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// Zero-order approximation (Altintas-Budak; exact for turning).
+    Zoa,
+    /// First-order full discretization.
+    Fdm,
+    /// First-order semi-discretization.
+    Sdm,
+}
+
+impl Method {
+    fn solver(self) -> Option<Discretization> {
+        match self {
+            Method::Zoa => None,
+            Method::Fdm => Some(Discretization::full()),
+            Method::Sdm => Some(Discretization::semi()),
+        }
+    }
+}
+
+/// `chatter check`.
+pub fn check(model: &Path, observations: Option<&Path>) -> Result<()> {
+    let m = inputs::model(model)?;
+    let mut line = format!(
+        "{}: {} model with {} modes",
+        model.display(),
+        match m.operation() {
+            chatter_dynamics::Operation::Milling(_) => "milling",
+            chatter_dynamics::Operation::Turning(_) => "turning",
+        },
+        m.mode_count()
+    );
+    if let Some(o) = observations {
+        let obs = inputs::observations(o)?;
+        let _ = write!(
+            line,
+            "; {}: {} cuts, {} poles, {} signals",
+            o.display(),
+            obs.cuts.len(),
+            obs.poles.len(),
+            obs.signals.len()
+        );
+    }
+    println!("{line}");
+    Ok(())
+}
+
+/// `chatter frf`.
+pub fn frf(
+    model_path: &Path,
+    range_hz: Option<(f64, f64)>,
+    points: usize,
+    coordinates: (Option<String>, Option<String>),
+    out: Option<&Path>,
+    plot: Option<&Path>,
+) -> Result<()> {
+    let model = inputs::model(model_path)?;
+    let op = model.operation();
+    let index = |name: Option<String>| -> Result<usize> {
+        match name {
+            None => Ok(0),
+            Some(n) => op.coordinate_index(&n).with_context(|| {
+                let names: Vec<_> = op.coordinates().iter().map(|c| c.name()).collect();
+                format!("coordinate `{n}` is not one of {names:?}")
+            }),
+        }
+    };
+    let (i, j) = (index(coordinates.0)?, index(coordinates.1)?);
+    let f_max = model
+        .modes()
+        .iter()
+        .map(|m| m.frequency_hz())
+        .fold(0.0, f64::max);
+    let (f0, f1) = range_hz.unwrap_or((0.0, 2.0 * f_max));
+    if !(f0 >= 0.0 && f1 > f0 && points >= 2) {
+        bail!(
+            "frequency range {f0}..{f1} Hz with {points} points: expected 0 <= min < max and >= 2 points"
+        );
+    }
+    let csv = frf_csv(&model, f0, f1, points, i, j);
+    emit(out, &csv)?;
+    if let Some(p) = plot {
+        let mag: Vec<(f64, f64)> = (0..points)
+            .map(|k| {
+                let f = f0 + (f1 - f0) * k as f64 / (points - 1) as f64;
+                (f, model.receptance(f, i, j).norm() * 1e6)
+            })
+            .collect();
+        let series = [Series {
+            label: format!(
+                "|G_{}{}|",
+                op.coordinates()[i].name(),
+                op.coordinates()[j].name()
+            ),
+            points: mag,
+            color: BLUE,
+            dashed: false,
+        }];
+        line_chart(
+            p,
+            "Receptance",
+            "frequency (Hz)",
+            "|G| (um/N)",
+            &series,
+            None,
+        )?;
+    }
+    Ok(())
+}
+
+fn frf_csv(model: &ModalModel, f0: f64, f1: f64, points: usize, i: usize, j: usize) -> String {
+    let mut csv = String::from("frequency_hz,real_m_per_n,imag_m_per_n,magnitude_m_per_n\n");
+    for k in 0..points {
+        let f = f0 + (f1 - f0) * k as f64 / (points - 1) as f64;
+        let g = model.receptance(f, i, j);
+        let _ = writeln!(csv, "{f},{:e},{:e},{:e}", g.re, g.im, g.norm());
+    }
+    csv
+}
+
+/// Default speed range: around the lobes of the dominant mode (lobe numbers ~1 to 10).
+fn default_speeds(model: &ModalModel) -> Vec<f64> {
+    let f = chatter_stability::boundary::dominant_mode_frequency_hz(model);
+    let n = model.operation().delays_per_revolution() as f64;
+    let max = (60.0 * f / n * 1.2).min(60_000.0);
+    let min = max / 10.0;
+    (0..200)
+        .map(|i| min + (max - min) * i as f64 / 199.0)
+        .collect()
+}
+
+/// Limiting depths with the chosen method.
+pub fn compute_lobes(
+    model: &ModalModel,
+    method: Method,
+    speeds: &[f64],
+    quiet: bool,
+) -> Result<Vec<LobePoint>> {
+    match method.solver() {
+        None => Ok(zoa_lobes(model, speeds)?),
+        Some(solver) => {
+            let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
+            let lobes = lobe_diagram(&solver, model, speeds, &BoundaryOptions::default(), &bar)?;
+            bar.finish();
+            Ok(lobes)
+        }
+    }
+}
+
+fn markers(obs: Option<&Observations>) -> Option<Markers> {
+    obs.map(|o| Markers {
+        stable: o
+            .cuts
+            .iter()
+            .filter(|c| c.stable)
+            .map(|c| (c.speed_rpm, c.depth_mm))
+            .collect(),
+        unstable: o
+            .cuts
+            .iter()
+            .filter(|c| !c.stable)
+            .map(|c| (c.speed_rpm, c.depth_mm))
+            .collect(),
+    })
+}
+
+fn lobes_csv(lobes: &[LobePoint]) -> String {
+    let mut csv = String::from("speed_rpm,depth_mm,chatter_hz\n");
+    for p in lobes {
+        let _ = writeln!(csv, "{},{},{}", p.speed_rpm, p.depth_mm(), p.chatter_hz);
+    }
+    csv
+}
+
+/// `chatter lobes`.
+pub fn lobes(
+    model_path: &Path,
+    method: Method,
+    speeds: Option<&str>,
+    observations: Option<&Path>,
+    out: Option<&Path>,
+    plot: Option<&Path>,
+    quiet: bool,
+) -> Result<()> {
+    let model = inputs::model(model_path)?;
+    let obs = observations.map(inputs::observations).transpose()?;
+    let speeds = match speeds {
+        Some(s) => inputs::speeds(s)?,
+        None => default_speeds(&model),
+    };
+    let lobes = compute_lobes(&model, method, &speeds, quiet)?;
+    emit(out, &lobes_csv(&lobes))?;
+    if let Some(p) = plot {
+        let series = [Series {
+            label: format!("{method:?} limiting depth").to_lowercase(),
+            points: lobes.iter().map(|l| (l.speed_rpm, l.depth_mm())).collect(),
+            color: BLUE,
+            dashed: false,
+        }];
+        line_chart(
+            p,
+            "Stability lobes",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            markers(obs.as_ref()).as_ref(),
+        )?;
+    }
+    Ok(())
+}
+
+/// `chatter multiplier`.
+pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Method) -> Result<()> {
+    let model = inputs::model(model_path)?;
+    let Some(solver) = method.solver() else {
+        bail!("--method zoa gives limiting depths, not multipliers; use fdm or sdm");
+    };
+    let (mu, chatter_hz) = solver.chatter_frequency_hz(&model, speed_rpm, depth_mm * 1e-3)?;
+    let json = serde_json::json!({
+        "speed_rpm": speed_rpm,
+        "depth_mm": depth_mm,
+        "method": solver.name(),
+        "modulus": mu.modulus(),
+        "real": mu.value.re,
+        "imag": mu.value.im,
+        "frequency_hz": mu.principal_frequency_hz(),
+        "chatter_hz": chatter_hz,
+        "kind": mu.kind(),
+        "stable": mu.modulus() < 1.0,
+    });
+    println!("{}", serde_json::to_string_pretty(&json)?);
+    Ok(())
+}
+
+/// `chatter bands --kind geometric`.
+#[allow(clippy::too_many_arguments)]
+pub fn bands_geometric(
+    model_path: &Path,
+    method: Method,
+    speeds: Option<&str>,
+    offset_rpm: f64,
+    offset_mm: f64,
+    observations: Option<&Path>,
+    out: Option<&Path>,
+    plot: Option<&Path>,
+    quiet: bool,
+) -> Result<()> {
+    let model = inputs::model(model_path)?;
+    let obs = observations.map(inputs::observations).transpose()?;
+    let speeds = match speeds {
+        Some(s) => inputs::speeds(s)?,
+        None => default_speeds(&model),
+    };
+    let lobes = compute_lobes(&model, method, &speeds, quiet)?;
+    let curve: Vec<(f64, f64)> = lobes
+        .iter()
+        .filter(|p| p.depth_m.is_finite())
+        .map(|p| (p.speed_rpm, p.depth_mm()))
+        .collect();
+    let bands = type_b_offsets(&curve, TypeBOffsets::new(offset_rpm, offset_mm)?)?;
+    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance\n");
+    for p in &bands.points {
+        let lo =
+            chatter_uncertainty::geometric::OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
+        let up =
+            chatter_uncertainty::geometric::OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
+        let fmt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{}",
+            p.speed_rpm,
+            p.depth_mm,
+            fmt(lo),
+            fmt(up),
+            p.theta_deg,
+            p.distance
+        );
+    }
+    emit(out, &csv)?;
+    if let Some(path) = plot {
+        let series = [
+            Series {
+                label: "mean boundary".into(),
+                points: curve,
+                color: BLUE,
+                dashed: false,
+            },
+            Series {
+                label: "lower offset".into(),
+                points: bands.lower.clone(),
+                color: RGBColor(200, 0, 0),
+                dashed: false,
+            },
+            Series {
+                label: "upper offset".into(),
+                points: bands.upper.clone(),
+                color: GREEN,
+                dashed: false,
+            },
+        ];
+        line_chart(
+            path,
+            "Type B offset boundaries",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            markers(obs.as_ref()).as_ref(),
+        )?;
+    }
+    Ok(())
+}
+
+/// `chatter demo`: the main job on the embedded examples, results into a folder.
+pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
+    use chatter_dynamics::examples;
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    let mut written = Vec::new();
+    let mut summary = serde_json::Map::new();
+
+    // 1. Turning case of seed 000: lobes (FDM and exact ZOA) over the tested speeds with the cuts.
+    let turning = examples::ahmadi_2022_turning();
+    let obs = examples::ahmadi_2022_turning_observations();
+    let speeds: Vec<f64> = (0..=120).map(|i| 6800.0 + 7.5 * i as f64).collect();
+    let fdm = compute_lobes(&turning, Method::Fdm, &speeds, quiet)?;
+    let path = out_dir.join("turning_lobes.csv");
+    write_atomic(&path, lobes_csv(&fdm).as_bytes())?;
+    written.push(path);
+    let path = out_dir.join("turning_lobes.svg");
+    line_chart(
+        &path,
+        "Seed 000 turning tool: nominal lobes (FDM) and test cuts",
+        "spindle speed (rpm)",
+        "width of cut (mm)",
+        &[Series {
+            label: "FDM limiting width".into(),
+            points: fdm.iter().map(|p| (p.speed_rpm, p.depth_mm())).collect(),
+            color: BLUE,
+            dashed: false,
+        }],
+        markers(Some(&obs)).as_ref(),
+    )?;
+    written.push(path);
+    let at = |rpm: f64| {
+        fdm.iter()
+            .min_by(|a, b| (a.speed_rpm - rpm).abs().total_cmp(&(b.speed_rpm - rpm).abs()))
+            .map(|p| serde_json::json!({"speed_rpm": p.speed_rpm, "depth_mm": p.depth_mm(), "chatter_hz": p.chatter_hz}))
+    };
+    summary.insert(
+        "turning_limits".into(),
+        serde_json::json!([at(6950.0), at(7150.0), at(7300.0), at(7500.0)]),
+    );
+
+    // 2. Milling example of seed 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm).
+    let milling = examples::schmitz_2023_milling();
+    let speeds: Vec<f64> = (0..=1000).map(|i| 4000.0 + 10.0 * i as f64).collect();
+    let zoa = zoa_lobes(&milling, &speeds)?;
+    let curve: Vec<(f64, f64)> = zoa
+        .iter()
+        .filter(|p| p.depth_m.is_finite())
+        .map(|p| (p.speed_rpm, p.depth_mm()))
+        .collect();
+    let bands = type_b_offsets(&curve, TypeBOffsets::new(100.0, 0.2)?)?;
+    let path = out_dir.join("milling_bands.svg");
+    line_chart(
+        &path,
+        "Seed 001 milling example: zero-order lobes with Type B offsets",
+        "spindle speed (rpm)",
+        "axial depth (mm)",
+        &[
+            Series {
+                label: "mean boundary".into(),
+                points: curve.clone(),
+                color: BLUE,
+                dashed: false,
+            },
+            Series {
+                label: "lower offset".into(),
+                points: bands.lower.clone(),
+                color: RGBColor(200, 0, 0),
+                dashed: false,
+            },
+            Series {
+                label: "upper offset".into(),
+                points: bands.upper.clone(),
+                color: GREEN,
+                dashed: false,
+            },
+        ],
+        None,
+    )?;
+    written.push(path);
+    let path = out_dir.join("milling_frf.csv");
+    write_atomic(&path, frf_csv(&milling, 0.0, 1500.0, 301, 0, 0).as_bytes())?;
+    written.push(path);
+
+    summary.insert(
+        "files".into(),
+        serde_json::json!(
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+        ),
+    );
+    let path = out_dir.join("summary.json");
+    write_atomic(&path, serde_json::to_string_pretty(&summary)?.as_bytes())?;
+    written.push(path);
+    for p in &written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,122 @@
+//! SVG plots with plotters' SVG backend (no system fonts needed).
+
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// A named polyline.
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// Points (x, y).
+    pub points: Vec<(f64, f64)>,
+    /// Colour.
+    pub color: RGBColor,
+    /// Dashed style (drawn as points when true).
+    pub dashed: bool,
+}
+
+/// Scatter markers for observed cuts.
+pub struct Markers {
+    /// Stable cuts (drawn as circles).
+    pub stable: Vec<(f64, f64)>,
+    /// Unstable cuts (drawn as crosses).
+    pub unstable: Vec<(f64, f64)>,
+}
+
+fn finite_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    (lo < hi).then_some((lo, hi))
+}
+
+/// Line chart of several series plus optional cut markers, written atomically to `path`.
+pub fn line_chart(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    markers: Option<&Markers>,
+) -> Result<()> {
+    let all = series.iter().flat_map(|s| s.points.iter().copied()).chain(
+        markers
+            .into_iter()
+            .flat_map(|m| m.stable.iter().chain(&m.unstable).copied()),
+    );
+    let pts: Vec<(f64, f64)> = all.collect();
+    let (x0, x1) =
+        finite_range(pts.iter().map(|p| p.0)).ok_or_else(|| anyhow!("nothing to plot"))?;
+    let (_, y1) = finite_range(pts.iter().map(|p| p.1)).unwrap_or((0.0, 1.0));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x0..x1, 0.0..y1 * 1.1)
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        for s in series {
+            let color = s.color;
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .collect();
+            if s.dashed {
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 1, color.filled())))
+                    .map_err(|e| anyhow!("{e}"))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+            } else {
+                chart
+                    .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+                    .map_err(|e| anyhow!("{e}"))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+            }
+        }
+        if let Some(m) = markers {
+            chart
+                .draw_series(
+                    m.stable
+                        .iter()
+                        .map(|&p| Circle::new(p, 5, BLACK.stroke_width(2))),
+                )
+                .map_err(|e| anyhow!("{e}"))?
+                .label("stable cut")
+                .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.stroke_width(2)));
+            chart
+                .draw_series(
+                    m.unstable
+                        .iter()
+                        .map(|&p| Cross::new(p, 6, RED.stroke_width(2))),
+                )
+                .map_err(|e| anyhow!("{e}"))?
+                .label("chatter")
+                .legend(|(x, y)| Cross::new((x + 10, y), 6, RED.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    crate::output::write_atomic(path, svg.as_bytes())
+}
