@@ -1,9 +1,13 @@
 //! Full- and semi-discretization of the time-periodic delay equation and its monodromy operator.
 //!
-//! In modal coordinates (N modes, state y = [q; q'] of size 2N) the cut obeys
-//! y' = (A_0 + A(t)) y + B(t) q(t - tau) with
+//! In modal coordinates (N modes, state `y = [q; q']` of size 2N) the cut obeys
+//!
+//! ```text
+//! y' = (A_0 + A(t)) y + B(t) q(t - tau),
 //! A_0 = [[0, I], [-Omega^2, -2 Z Omega]], A(t) = [[0, 0], [-b W(t), -b P(t)]], B(t) = [[0], [b W(t)]],
-//! W = Phi^T H(t) Phi (cutting, 000 Eq. 7-8, 002 Eq. 1-3) and P = Phi^T D(t) Phi (process damping,
+//! ```
+//!
+//! with W = Phi^T H(t) Phi (cutting, 000 Eq. 7-8, 002 Eq. 1-3) and P = Phi^T D(t) Phi (process damping,
 //! 003 Eq. 1).
 //!
 //! # Grid

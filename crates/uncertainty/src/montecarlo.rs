@@ -14,9 +14,9 @@ use crate::error::{Result, UncertaintyError};
 pub struct SampledBoundaries {
     /// Speeds (rpm).
     pub speeds_rpm: Vec<f64>,
-    /// limits_mm[s][i]: limiting depth of sample s at speeds_rpm[i].
+    /// `limits_mm[s][i]`: limiting depth of sample s at `speeds_rpm[i]`.
     pub limits_mm: Vec<Vec<f64>>,
-    /// chatter_hz[s][i]: chatter frequency on that boundary.
+    /// `chatter_hz[s][i]`: chatter frequency on that boundary.
     pub chatter_hz: Vec<Vec<f64>>,
 }
 
@@ -27,7 +27,7 @@ pub struct StabilityMap {
     pub speeds_rpm: Vec<f64>,
     /// Depths (mm).
     pub depths_mm: Vec<f64>,
-    /// p_stable[i][j] at speeds_rpm[i], depths_mm[j].
+    /// `p_stable[i][j]` at `speeds_rpm[i]`, `depths_mm[j]`.
     pub p_stable: Vec<Vec<f64>>,
 }
 

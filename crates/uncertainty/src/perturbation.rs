@@ -25,14 +25,14 @@ pub struct EigenSensitivity {
 /// Mean and variance of mu under theta ~ N(0, Sigma) (Eq. 17-18).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PerturbationMoments {
-    /// E[mu] (Eq. 17).
+    /// E(mu) (Eq. 17).
     pub mean: Complex64,
-    /// E[|mu - E mu|^2] (Eq. 18).
+    /// E(|mu - E mu|^2) (Eq. 18).
     pub variance: f64,
 }
 
 impl PerturbationMoments {
-    /// |E[mu]|, the modulus that sets the mean boundary.
+    /// The modulus of E(mu), which sets the mean boundary.
     pub fn mean_modulus(&self) -> f64 {
         self.mean.norm()
     }
@@ -90,7 +90,7 @@ pub struct MomentGrid {
     pub speeds_rpm: Vec<f64>,
     /// Depths (mm), increasing.
     pub depths_mm: Vec<f64>,
-    /// moments[i][j] at speeds_rpm[i], depths_mm[j].
+    /// `moments[i][j]` at `speeds_rpm[i]`, `depths_mm[j]`.
     pub moments: Vec<Vec<PerturbationMoments>>,
 }
 

@@ -243,7 +243,7 @@ impl TurningPoleLikelihood {
         let Some((&var_r, theta_m)) = theta.split_last() else {
             return f64::NEG_INFINITY;
         };
-        if !(var_r > 0.0) || theta_m.len() != self.parameters.len() {
+        if var_r.is_nan() || var_r <= 0.0 || theta_m.len() != self.parameters.len() {
             return f64::NEG_INFINITY;
         }
         let Ok(res) = self.normalized_residuals(theta_m) else {
