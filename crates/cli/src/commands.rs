@@ -427,3 +427,75 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     }
     Ok(())
 }
+
+/// `chatter simulate`: a simulated cut as signals CSV (header = channel names, first channel the
+/// reference) or 32-bit float WAV (channels in the same order: coordinates, then once_per_rev).
+pub fn simulate(
+    model_path: &Path,
+    settings: &chatter_dynamics::simulate::SimulationSettings,
+    out: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let model = inputs::model(model_path)?;
+    let bar = Bar::new(1000, "simulate", quiet);
+    let sim = chatter_dynamics::simulate::simulate_with_observer(&model, settings, &bar)?;
+    bar.finish();
+    let is_wav = out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("wav"));
+    if is_wav {
+        let spec = hound::WavSpec {
+            channels: sim.channels.len() as u16,
+            sample_rate: sim.sample_rate_hz.round() as u32,
+            bits_per_sample: 32,
+            sample_format: hound::SampleFormat::Float,
+        };
+        if (spec.sample_rate as f64 - sim.sample_rate_hz).abs() > 1e-9 {
+            bail!(
+                "--sample-rate-hz {} is not an integer; WAV needs an integer rate",
+                sim.sample_rate_hz
+            );
+        }
+        let mut buffer = std::io::Cursor::new(Vec::new());
+        {
+            let mut writer =
+                hound::WavWriter::new(&mut buffer, spec).context("starting the WAV stream")?;
+            let n = sim.channels[0].data.len();
+            for k in 0..n {
+                for c in &sim.channels {
+                    writer
+                        .write_sample(c.data[k] as f32)
+                        .context("writing WAV samples")?;
+                }
+            }
+            writer.finalize().context("finishing the WAV stream")?;
+        }
+        write_atomic(out, buffer.get_ref())?;
+    } else {
+        let mut csv = sim
+            .channels
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(",");
+        csv.push('\n');
+        let n = sim.channels[0].data.len();
+        for k in 0..n {
+            let row: Vec<String> = sim
+                .channels
+                .iter()
+                .map(|c| format!("{:e}", c.data[k]))
+                .collect();
+            csv.push_str(&row.join(","));
+            csv.push('\n');
+        }
+        write_atomic(out, csv.as_bytes())?;
+    }
+    eprintln!(
+        "wrote {} ({} samples, lost contact {:.1} %)",
+        out.display(),
+        sim.channels[0].data.len(),
+        100.0 * sim.lost_contact_fraction
+    );
+    Ok(())
+}

@@ -129,12 +129,59 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Simulate a cut in the time domain; writes a signals CSV or a WAV file.
+    Simulate {
+        /// Model file.
+        #[arg(long)]
+        model: PathBuf,
+        /// Spindle speed (rpm).
+        #[arg(long)]
+        speed_rpm: f64,
+        /// Depth (milling) or width (turning) of cut (mm).
+        #[arg(long)]
+        depth_mm: f64,
+        /// Signal length (s).
+        #[arg(long)]
+        duration_s: f64,
+        /// Output sample rate (Hz).
+        #[arg(long)]
+        sample_rate_hz: f64,
+        /// Seed of the random force.
+        #[arg(long)]
+        seed: u64,
+        /// Output file, .csv or .wav.
+        #[arg(long)]
+        out: PathBuf,
+        /// Output quantity.
+        #[arg(long, value_enum, default_value = "acceleration")]
+        quantity: QuantityArg,
+        /// RMS of the broadband random force per coordinate (N).
+        #[arg(long, default_value_t = 1.0)]
+        random_force_n: f64,
+        /// Amplitude of spindle-harmonic forcing (N).
+        #[arg(long, default_value_t = 0.0)]
+        harmonic_force_n: f64,
+        /// Feed per tooth (milling) or per revolution (turning), mm.
+        #[arg(long, default_value_t = 0.05)]
+        feed_per_tooth_mm: f64,
+    },
     /// Run the main job on the embedded examples and write the results to a folder.
     Demo {
         /// Output folder.
         #[arg(long, default_value = "demo-output")]
         out: PathBuf,
     },
+}
+
+/// Output quantities of `simulate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum QuantityArg {
+    /// m/s^2.
+    Acceleration,
+    /// m/s.
+    Velocity,
+    /// m.
+    Displacement,
 }
 
 /// Band kinds.
@@ -218,6 +265,37 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plot.as_deref(),
             quiet,
         ),
+        Command::Simulate {
+            model,
+            speed_rpm,
+            depth_mm,
+            duration_s,
+            sample_rate_hz,
+            seed,
+            out,
+            quantity,
+            random_force_n,
+            harmonic_force_n,
+            feed_per_tooth_mm,
+        } => {
+            use chatter_dynamics::simulate::{Quantity, SimulationSettings};
+            let mut s = SimulationSettings::new(
+                speed_rpm,
+                depth_mm * 1e-3,
+                duration_s,
+                sample_rate_hz,
+                seed,
+            );
+            s.quantity = match quantity {
+                QuantityArg::Acceleration => Quantity::Acceleration,
+                QuantityArg::Velocity => Quantity::Velocity,
+                QuantityArg::Displacement => Quantity::Displacement,
+            };
+            s.random_force_rms_n = random_force_n;
+            s.harmonic_force_n = harmonic_force_n;
+            s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
+            commands::simulate(&model, &s, &out, quiet)
+        }
         Command::Demo { out } => commands::demo(&out, quiet),
     }
 }

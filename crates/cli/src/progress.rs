@@ -31,3 +31,9 @@ impl BoundaryObserver for Bar {
         self.0.set_position(done as u64);
     }
 }
+
+impl chatter_dynamics::simulate::SimulationObserver for Bar {
+    fn progress(&self, fraction: f64) {
+        self.0.set_position((fraction * 1000.0) as u64);
+    }
+}
