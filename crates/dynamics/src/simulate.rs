@@ -107,7 +107,7 @@ impl SimulationSettings {
             }
         }
         let samples = self.duration_s * self.sample_rate_hz;
-        if samples < 2.0 || samples > 1e9 {
+        if !(2.0..=1e9).contains(&samples) {
             return Err(DynamicsError::value(
                 "duration_s",
                 self.duration_s,
@@ -146,6 +146,9 @@ pub trait SimulationObserver {
 
 struct Silent;
 impl SimulationObserver for Silent {}
+
+/// Per mode: ZOH transition (row-major 2x2), input vector, shape, omega_n, zeta_n.
+type ModeStep = ([f64; 4], [f64; 2], [f64; 2], f64, f64);
 
 /// Simulate a cut.
 pub fn simulate(model: &ModalModel, settings: &SimulationSettings) -> Result<Simulation> {
@@ -196,7 +199,7 @@ pub fn simulate_with_observer(
     let h = tau / steps_per_delay as f64;
     let total_steps = (settings.duration_s / h).ceil() as usize + 2;
 
-    let modes: Vec<([f64; 4], [f64; 2], [f64; 2], f64, f64)> = model
+    let modes: Vec<ModeStep> = model
         .modes()
         .iter()
         .map(|m| {

@@ -1,0 +1,42 @@
+//! Stability solver speed: the dominant multiplier of the single-DOF benchmark at m = 40, a
+//! 200-speed FDM lobe diagram at m = 40, and the seed-000 turning multiplier at the default
+//! resolution.
+use chatter_dynamics::examples;
+use chatter_stability::StabilitySolver;
+use chatter_stability::boundary::{BoundaryOptions, Silent, lobe_diagram, speed_range};
+use chatter_stability::monodromy::Discretization;
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn bench(c: &mut Criterion) {
+    let benchmark = examples::insperger_benchmark(1.0);
+    let fdm40 = Discretization::full().with_steps(40);
+    let sdm40 = Discretization::semi().with_steps(40);
+    c.bench_function("multiplier_sdof_fdm_m40", |b| {
+        b.iter(|| fdm40.dominant_multiplier(&benchmark, 10_000.0, 0.3e-3))
+    });
+    c.bench_function("multiplier_sdof_sdm_m40", |b| {
+        b.iter(|| sdm40.dominant_multiplier(&benchmark, 10_000.0, 0.3e-3))
+    });
+    let turning = examples::ahmadi_2022_turning();
+    c.bench_function("multiplier_turning_fdm_auto", |b| {
+        b.iter(|| Discretization::full().dominant_multiplier(&turning, 7150.0, 2.286e-3))
+    });
+    let speeds = speed_range(5000.0, 25_000.0, 200).unwrap_or_default();
+    let mut group = c.benchmark_group("lobes");
+    group.sample_size(10);
+    group.bench_function("lobes_200_speeds_fdm_m40", |b| {
+        b.iter(|| {
+            lobe_diagram(
+                &fdm40,
+                &benchmark,
+                &speeds,
+                &BoundaryOptions::default(),
+                &Silent,
+            )
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
