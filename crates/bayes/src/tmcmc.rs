@@ -1,0 +1,303 @@
+//! Transitional MCMC (Ching and Chen 2007) and its improved variant iTMCMC (Betz, Papaioannou
+//! and Straub 2016), with the model evidence.
+//!
+//! Stage j samples p_j(theta) ~ p(theta) L(theta)^beta_j, beta from 0 to 1. The step
+//! beta_{j+1} - beta_j is chosen so the coefficient of variation of the plausibility weights
+//! w_i = L(theta_i)^(beta_{j+1} - beta_j) equals the target (1), by bisection on max-shifted log
+//! weights. ln p(D) = sum_j ln mean(w) (evidence). Samples are resampled by weight and moved by
+//! Metropolis-Hastings chains with Gaussian proposals of covariance c^2 Sigma_w (weighted sample
+//! covariance). iTMCMC adapts c towards an acceptance rate of 0.21 and burns in the chains.
+//!
+//! Every chain draws from its own random stream seeded by (seed, stage, chain), and likelihoods are
+//! evaluated in parallel with rayon, so results do not depend on the number of threads.
+
+use crate::error::{BayesError, Result};
+use crate::prior::Prior;
+use crate::samples::SampleSet;
+use nalgebra::{DMatrix, DVector};
+use rand::SeedableRng;
+use rand::rngs::StdRng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+
+/// A log-likelihood ln p(D | theta); -inf where theta is impossible.
+pub trait LogLikelihood: Sync {
+    /// ln p(D | theta).
+    fn ln_likelihood(&self, theta: &[f64]) -> f64;
+}
+
+impl<F: Fn(&[f64]) -> f64 + Sync> LogLikelihood for F {
+    fn ln_likelihood(&self, theta: &[f64]) -> f64 {
+        self(theta)
+    }
+}
+
+/// Progress of a sampler; no-op by default.
+pub trait SamplerObserver: Sync {
+    /// After each stage: index, beta, acceptance rate.
+    fn stage(&self, _index: usize, _beta: f64, _acceptance: f64) {}
+}
+
+/// The observer that does nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Silent;
+impl SamplerObserver for Silent {}
+
+/// Which variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variant {
+    /// Ching and Chen: fixed proposal scale 0.2, one MH step per chain and sample.
+    Classic,
+    /// Betz et al.: adaptive scale towards acceptance 0.21, burn-in.
+    Improved,
+}
+
+/// Options of the sampler.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TmcmcOptions {
+    /// Number of samples per stage.
+    pub samples: usize,
+    /// Target coefficient of variation of the weights (1).
+    pub target_cov: f64,
+    /// MH steps per chain and stage (after burn-in).
+    pub steps: usize,
+    /// Burn-in steps per chain (iTMCMC).
+    pub burn_in: usize,
+    /// Variant.
+    pub variant: Variant,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl Default for TmcmcOptions {
+    /// 2000 samples, CoV 1, 6 steps, burn-in 4, iTMCMC, seed 0.
+    fn default() -> Self {
+        Self {
+            samples: 2000,
+            target_cov: 1.0,
+            steps: 6,
+            burn_in: 4,
+            variant: Variant::Improved,
+            seed: 0,
+        }
+    }
+}
+
+/// Result of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TmcmcResult {
+    /// Equally weighted posterior samples.
+    pub samples: SampleSet,
+    /// ln of the log-likelihood at each final sample.
+    pub ln_likelihoods: Vec<f64>,
+    /// ln p(D | M).
+    pub log_evidence: f64,
+    /// Tempering schedule beta_0 = 0, ..., 1.
+    pub betas: Vec<f64>,
+    /// Mean acceptance per stage.
+    pub acceptance: Vec<f64>,
+}
+
+impl TmcmcResult {
+    /// Posterior mean of the log-likelihood: the data-fit term of 000 Eq. 33.
+    pub fn data_fit(&self) -> f64 {
+        self.ln_likelihoods.iter().sum::<f64>() / self.ln_likelihoods.len() as f64
+    }
+    /// Information gain E[ln posterior / prior] = data fit - log evidence (000 Eq. 33).
+    pub fn information_gain(&self) -> f64 {
+        self.data_fit() - self.log_evidence
+    }
+}
+
+fn stream(seed: u64, stage: usize, chain: usize) -> StdRng {
+    // SplitMix64-style mixing of the three indices
+    let mut z = seed
+        ^ (stage as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (chain as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    StdRng::seed_from_u64(z ^ (z >> 31))
+}
+
+fn log_mean_exp(x: &[f64]) -> f64 {
+    let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !m.is_finite() {
+        return m;
+    }
+    m + (x.iter().map(|v| (v - m).exp()).sum::<f64>() / x.len() as f64).ln()
+}
+
+fn cov_of_weights(ln_l: &[f64], dbeta: f64) -> f64 {
+    let m = ln_l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let w: Vec<f64> = ln_l.iter().map(|l| (dbeta * (l - m)).exp()).collect();
+    let mean = w.iter().sum::<f64>() / w.len() as f64;
+    let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / w.len() as f64;
+    var.sqrt() / mean
+}
+
+/// Run TMCMC / iTMCMC.
+pub fn tmcmc<P: Prior, L: LogLikelihood>(
+    prior: &P,
+    likelihood: &L,
+    options: &TmcmcOptions,
+    observer: &dyn SamplerObserver,
+) -> Result<TmcmcResult> {
+    let n = options.samples;
+    let d = prior.dimension();
+    if n < 10 || options.target_cov <= 0.0 || options.steps == 0 {
+        return Err(BayesError::InvalidInput {
+            field: "options",
+            message: format!("{options:?}: need >= 10 samples, target CoV > 0, >= 1 step"),
+        });
+    }
+    let mut theta: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|i| prior.sample(&mut stream(options.seed, 0, i)))
+        .collect();
+    let mut ln_l: Vec<f64> = theta
+        .par_iter()
+        .map(|t| likelihood.ln_likelihood(t))
+        .collect();
+    if ln_l.iter().all(|l| !l.is_finite()) {
+        return Err(BayesError::Degenerate(
+            "the likelihood is zero at every prior sample".into(),
+        ));
+    }
+    let mut beta = 0.0;
+    let mut betas = vec![0.0];
+    let mut acceptance = Vec::new();
+    let mut log_evidence = 0.0;
+    let mut scale = 2.38 / (d as f64).sqrt();
+    let mut stage = 0;
+    while beta < 1.0 {
+        stage += 1;
+        // tempering step by bisection on the weights' coefficient of variation
+        let remaining = 1.0 - beta;
+        let dbeta = if cov_of_weights(&ln_l, remaining) <= options.target_cov {
+            remaining
+        } else {
+            let (mut lo, mut hi) = (0.0, remaining);
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if cov_of_weights(&ln_l, mid) > options.target_cov {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            lo.max(1e-12)
+        };
+        beta = (beta + dbeta).min(1.0);
+        let ln_w: Vec<f64> = ln_l.iter().map(|l| dbeta * l).collect();
+        log_evidence += log_mean_exp(&ln_w);
+        let m = ln_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let w: Vec<f64> = ln_w.iter().map(|x| (x - m).exp()).collect();
+        let total: f64 = w.iter().sum();
+        let weights: Vec<f64> = w.iter().map(|x| x / total).collect();
+        // weighted covariance of the current samples
+        let mut mean = DVector::zeros(d);
+        for (t, wi) in theta.iter().zip(&weights) {
+            mean += DVector::from_column_slice(t) * *wi;
+        }
+        let mut cov = DMatrix::zeros(d, d);
+        for (t, wi) in theta.iter().zip(&weights) {
+            let dv = DVector::from_column_slice(t) - &mean;
+            cov += &dv * dv.transpose() * *wi;
+        }
+        let jitter = 1e-12 * (cov.trace() / d as f64).max(1e-300);
+        let chol = (cov + DMatrix::identity(d, d) * jitter)
+            .cholesky()
+            .ok_or_else(|| {
+                BayesError::Degenerate("sample covariance is not positive definite".into())
+            })?
+            .l();
+        // systematic resampling (deterministic given the weights and one uniform per stage)
+        let mut rng = stream(options.seed, stage, usize::MAX);
+        let u0: f64 = rand::Rng::random::<f64>(&mut rng) / n as f64;
+        let mut idx = Vec::with_capacity(n);
+        let (mut c, mut k) = (weights[0], 0);
+        for i in 0..n {
+            let u = u0 + i as f64 / n as f64;
+            while u > c && k + 1 < n {
+                k += 1;
+                c += weights[k];
+            }
+            idx.push(k);
+        }
+        let burn = if options.variant == Variant::Improved {
+            options.burn_in
+        } else {
+            0
+        };
+        let steps = options.steps + burn;
+        let c_scale = if options.variant == Variant::Improved {
+            scale
+        } else {
+            0.2
+        };
+        let moved: Vec<(Vec<f64>, f64, usize)> = idx
+            .par_iter()
+            .enumerate()
+            .map(|(chain, &start)| {
+                let mut rng = stream(options.seed, stage, chain);
+                let mut x = theta[start].clone();
+                let mut lx = ln_l[start];
+                let mut px = prior.ln_pdf(&x);
+                let mut accepted = 0;
+                for _ in 0..steps {
+                    let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
+                    let step = &chol * z * c_scale;
+                    let y: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+                    let py = prior.ln_pdf(&y);
+                    if !py.is_finite() {
+                        continue;
+                    }
+                    let ly = likelihood.ln_likelihood(&y);
+                    let log_ratio = py + beta * ly - px - beta * lx;
+                    let u: f64 = rand::Rng::random::<f64>(&mut rng);
+                    if log_ratio >= 0.0 || u.ln() < log_ratio {
+                        x = y;
+                        lx = ly;
+                        px = py;
+                        accepted += 1;
+                    }
+                }
+                (x, lx, accepted)
+            })
+            .collect();
+        let acc = moved.iter().map(|m| m.2).sum::<usize>() as f64 / (n * steps) as f64;
+        theta = moved.iter().map(|m| m.0.clone()).collect();
+        ln_l = moved.iter().map(|m| m.1).collect();
+        acceptance.push(acc);
+        if options.variant == Variant::Improved {
+            // Betz et al.: move the scale towards acceptance 0.21
+            scale *= ((acc - 0.21) * 2.0).exp();
+        }
+        betas.push(beta);
+        observer.stage(stage, beta, acc);
+        if stage > 1000 {
+            return Err(BayesError::Degenerate(
+                "more than 1000 tempering stages".into(),
+            ));
+        }
+    }
+    Ok(TmcmcResult {
+        samples: SampleSet::equally_weighted(theta)?,
+        ln_likelihoods: ln_l,
+        log_evidence,
+        betas,
+        acceptance,
+    })
+}
+
+/// Posterior probabilities of model classes from their log-evidences (equal prior
+/// probabilities; 000 Eq. 32).
+pub fn class_probabilities(log_evidences: &[f64]) -> Vec<f64> {
+    let m = log_evidences
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let w: Vec<f64> = log_evidences.iter().map(|l| (l - m).exp()).collect();
+    let s: f64 = w.iter().sum();
+    w.iter().map(|x| x / s).collect()
+}
