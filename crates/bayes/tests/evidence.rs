@@ -6,6 +6,26 @@ use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_bayes::tmcmc::{Silent, TmcmcOptions, tmcmc};
 use std::f64::consts::PI;
 
+/// Mean over seeds 0..3 of (log-evidence - exact), with N = 2000, and the runs.
+fn evidence_error<L: Fn(&[f64]) -> f64 + Sync>(
+    prior: &IndependentPrior,
+    like: &L,
+    exact: f64,
+) -> (f64, Vec<chatter_bayes::tmcmc::TmcmcResult>) {
+    let runs: Vec<_> = (0..3)
+        .map(|seed| {
+            let opts = TmcmcOptions {
+                samples: 2000,
+                seed,
+                ..Default::default()
+            };
+            tmcmc(prior, like, &opts, &Silent).unwrap()
+        })
+        .collect();
+    let err = runs.iter().map(|r| r.log_evidence - exact).sum::<f64>() / 3.0;
+    (err, runs)
+}
+
 /// Prior N(0, 1), likelihood N(5; theta, 0.2^2): evidence N(5; 0, 1.04), posterior
 /// N(5/1.04, 0.04/1.04).
 #[test]
@@ -13,20 +33,8 @@ fn normal_normal_evidence() {
     let prior = IndependentPrior::new(vec![Marginal::Normal { mean: 0.0, sd: 1.0 }]).unwrap();
     let like = |t: &[f64]| -0.5 * ((5.0 - t[0]) / 0.2).powi(2) - (0.2 * (2.0 * PI).sqrt()).ln();
     let exact = -0.5 * (2.0 * PI * 1.04).ln() - 25.0 / (2.0 * 1.04);
-    let mut err = 0.0;
-    for seed in 0..3 {
-        let run = tmcmc(
-            &prior,
-            &like,
-            &TmcmcOptions {
-                samples: 2000,
-                seed,
-                ..Default::default()
-            },
-            &Silent,
-        )
-        .unwrap();
-        err += (run.log_evidence - exact) / 3.0;
+    let (err, runs) = evidence_error(&prior, &like, exact);
+    for run in &runs {
         let m = run.samples.mean()[0];
         let v = run.samples.covariance()[(0, 0)];
         // MC error of the mean ~ sqrt(v / ESS); ESS of TMCMC ~ N/5 at worst
@@ -56,20 +64,8 @@ fn conjugate_gaussian_2_and_10_dimensions() {
             .iter()
             .map(|b| -0.5 * (2.0 * PI * (1.0 + s2)).ln() - b * b / (2.0 * (1.0 + s2)))
             .sum();
-        let mut err = 0.0;
-        for seed in 0..3 {
-            let run = tmcmc(
-                &prior,
-                &like,
-                &TmcmcOptions {
-                    samples: 2000,
-                    seed,
-                    ..Default::default()
-                },
-                &Silent,
-            )
-            .unwrap();
-            err += (run.log_evidence - exact) / 3.0;
+        let (err, runs) = evidence_error(&prior, &like, exact);
+        for run in &runs {
             let m = run.samples.mean();
             // posterior sd sqrt(s2 / (1 + s2)) = 0.447; with an effective sample size of N/5 the
             // Monte Carlo error of a mean is 0.022: allow 4.5 of those
@@ -89,21 +85,7 @@ fn one_sided_likelihood_evidence() {
     let phi = |x: f64| 0.5 * chatter_bayes::prior::erfc(-x / std::f64::consts::SQRT_2);
     let like = move |t: &[f64]| phi((a - t[0]) / s).ln();
     let exact = phi(a / (1.0f64 + s * s).sqrt()).ln();
-    let mut err = 0.0;
-    for seed in 0..3 {
-        let run = tmcmc(
-            &prior,
-            &like,
-            &TmcmcOptions {
-                samples: 2000,
-                seed,
-                ..Default::default()
-            },
-            &Silent,
-        )
-        .unwrap();
-        err += (run.log_evidence - exact) / 3.0;
-    }
+    let (err, _) = evidence_error(&prior, &like, exact);
     assert!(err.abs() < 0.15, "mean log-evidence error {err}");
 }
 

@@ -189,6 +189,23 @@ fn lobes_csv(lobes: &[LobePoint]) -> String {
     csv
 }
 
+/// Read the model and observations, pick the speeds and compute the limiting depths.
+fn load_and_compute(
+    model_path: &Path,
+    method: Method,
+    speeds: Option<&str>,
+    observations: Option<&Path>,
+    quiet: bool,
+) -> Result<(Option<Observations>, Vec<LobePoint>)> {
+    let model = inputs::model(model_path)?;
+    let obs = observations.map(inputs::observations).transpose()?;
+    let speeds = match speeds {
+        Some(s) => inputs::speeds(s)?,
+        None => default_speeds(&model),
+    };
+    Ok((obs, compute_lobes(&model, method, &speeds, quiet)?))
+}
+
 /// `chatter lobes`.
 pub fn lobes(
     model_path: &Path,
@@ -199,13 +216,7 @@ pub fn lobes(
     plot: Option<&Path>,
     quiet: bool,
 ) -> Result<()> {
-    let model = inputs::model(model_path)?;
-    let obs = observations.map(inputs::observations).transpose()?;
-    let speeds = match speeds {
-        Some(s) => inputs::speeds(s)?,
-        None => default_speeds(&model),
-    };
-    let lobes = compute_lobes(&model, method, &speeds, quiet)?;
+    let (obs, lobes) = load_and_compute(model_path, method, speeds, observations, quiet)?;
     emit(out, &lobes_csv(&lobes))?;
     if let Some(p) = plot {
         let series = [Series {
@@ -262,13 +273,7 @@ pub fn bands_geometric(
     plot: Option<&Path>,
     quiet: bool,
 ) -> Result<()> {
-    let model = inputs::model(model_path)?;
-    let obs = observations.map(inputs::observations).transpose()?;
-    let speeds = match speeds {
-        Some(s) => inputs::speeds(s)?,
-        None => default_speeds(&model),
-    };
-    let lobes = compute_lobes(&model, method, &speeds, quiet)?;
+    let (obs, lobes) = load_and_compute(model_path, method, speeds, observations, quiet)?;
     let curve: Vec<(f64, f64)> = lobes
         .iter()
         .filter(|p| p.depth_m.is_finite())
@@ -295,26 +300,7 @@ pub fn bands_geometric(
     }
     emit(out, &csv)?;
     if let Some(path) = plot {
-        let series = [
-            Series {
-                label: "mean boundary".into(),
-                points: curve,
-                color: BLUE,
-                dashed: false,
-            },
-            Series {
-                label: "lower offset".into(),
-                points: bands.lower.clone(),
-                color: RGBColor(200, 0, 0),
-                dashed: false,
-            },
-            Series {
-                label: "upper offset".into(),
-                points: bands.upper.clone(),
-                color: GREEN,
-                dashed: false,
-            },
-        ];
+        let series = band_series(curve, &bands);
         line_chart(
             path,
             "Type B offset boundaries",
@@ -325,6 +311,24 @@ pub fn bands_geometric(
         )?;
     }
     Ok(())
+}
+
+/// Mean boundary with its lower and upper offsets, for plotting.
+fn band_series(
+    curve: Vec<(f64, f64)>,
+    bands: &chatter_uncertainty::geometric::OffsetBoundaries,
+) -> [Series; 3] {
+    let line = |label: &str, points: Vec<(f64, f64)>, color: RGBColor| Series {
+        label: label.into(),
+        points,
+        color,
+        dashed: false,
+    };
+    [
+        line("mean boundary", curve, BLUE),
+        line("lower offset", bands.lower.clone(), RGBColor(200, 0, 0)),
+        line("upper offset", bands.upper.clone(), GREEN),
+    ]
 }
 
 /// `chatter demo`: the main job on the embedded examples, results into a folder.
@@ -383,26 +387,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         "Seed 001 milling example: zero-order lobes with Type B offsets",
         "spindle speed (rpm)",
         "axial depth (mm)",
-        &[
-            Series {
-                label: "mean boundary".into(),
-                points: curve.clone(),
-                color: BLUE,
-                dashed: false,
-            },
-            Series {
-                label: "lower offset".into(),
-                points: bands.lower.clone(),
-                color: RGBColor(200, 0, 0),
-                dashed: false,
-            },
-            Series {
-                label: "upper offset".into(),
-                points: bands.upper.clone(),
-                color: GREEN,
-                dashed: false,
-            },
-        ],
+        &band_series(curve.clone(), &bands),
         None,
     )?;
     written.push(path);
