@@ -9,6 +9,7 @@
 
 pub mod boundary;
 pub mod error;
+pub mod frequency_domain;
 pub mod monodromy;
 pub mod multiplier;
 pub mod zero_order;
