@@ -162,6 +162,32 @@ fn first_crossing(depths: &[f64], g: &[f64]) -> Option<f64> {
     })
 }
 
+/// [`MomentGrid`] for a machining model: Eq. 15-16 from the discretized transition matrix of
+/// `method` for the named `parameters`, then Eq. 17-18 with covariance `sigma`.
+pub fn model_moment_grid(
+    method: chatter_stability::monodromy::Discretization,
+    model: &chatter_dynamics::ModalModel,
+    parameters: &[chatter_dynamics::Parameter],
+    sigma: &DMatrix<f64>,
+    speeds_rpm: &[f64],
+    depths_mm: &[f64],
+) -> Result<MomentGrid> {
+    MomentGrid::evaluate(speeds_rpm, depths_mm, sigma, |speed, depth_mm| {
+        let s = chatter_stability::sensitivity::eigenvalue_sensitivity(
+            method,
+            model,
+            parameters,
+            speed,
+            depth_mm * 1e-3,
+        )?;
+        Ok(EigenSensitivity {
+            mu: s.mu,
+            gradient: s.gradient,
+            hessian: s.hessian,
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -247,30 +273,4 @@ mod tests {
         }
         assert!(widths[1] > widths[0]);
     }
-}
-
-/// [`MomentGrid`] for a machining model: Eq. 15-16 from the discretized transition matrix of
-/// `method` for the named `parameters`, then Eq. 17-18 with covariance `sigma`.
-pub fn model_moment_grid(
-    method: chatter_stability::monodromy::Discretization,
-    model: &chatter_dynamics::ModalModel,
-    parameters: &[chatter_dynamics::Parameter],
-    sigma: &DMatrix<f64>,
-    speeds_rpm: &[f64],
-    depths_mm: &[f64],
-) -> Result<MomentGrid> {
-    MomentGrid::evaluate(speeds_rpm, depths_mm, sigma, |speed, depth_mm| {
-        let s = chatter_stability::sensitivity::eigenvalue_sensitivity(
-            method,
-            model,
-            parameters,
-            speed,
-            depth_mm * 1e-3,
-        )?;
-        Ok(EigenSensitivity {
-            mu: s.mu,
-            gradient: s.gradient,
-            hessian: s.hessian,
-        })
-    })
 }
