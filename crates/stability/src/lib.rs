@@ -12,6 +12,7 @@ pub mod error;
 pub mod frequency_domain;
 pub mod monodromy;
 pub mod multiplier;
+pub mod process_damping;
 pub mod sensitivity;
 pub mod zero_order;
 
