@@ -309,6 +309,7 @@ impl Monodromy {
                     DMatrix::zeros(0, 0),
                 ),
             };
+            let mut carried: Option<(DMatrix<f64>, DMatrix<f64>)> = None;
             // constant coefficients (turning): every step of the segment is the same
             let constant = matches!(model.operation(), Operation::Turning(_));
             for i in 0..k {
@@ -325,8 +326,13 @@ impl Monodromy {
                     Scheme::Full => {
                         // products interpolated just inside the segment (H is smooth there)
                         let eps = 1e-9 * h;
-                        let (ai, bi) = a_of(t0 + eps);
+                        // the end of step i is the start of step i + 1 (same smooth segment)
+                        let (ai, bi) = match carried.take() {
+                            Some(x) => x,
+                            None => a_of(t0 + eps),
+                        };
                         let (aj, bj) = a_of(t0 + h - eps);
+                        carried = Some((aj.clone(), bj.clone()));
                         let lhs = DMatrix::identity(2 * n, 2 * n) - &f2 * &aj / h;
                         let lu = lhs.lu();
                         let c1 = &f1 - &f2 / h;
@@ -539,7 +545,7 @@ const ARNOLDI_DIM: usize = 20;
 /// Maximum restarts.
 const ARNOLDI_RESTARTS: usize = 40;
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
-const ARNOLDI_TOL: f64 = 1e-11;
+const ARNOLDI_TOL: f64 = 1e-10;
 
 fn arnoldi(op: &Monodromy, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
     let k = ARNOLDI_DIM.min(d - 1);
