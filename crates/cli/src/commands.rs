@@ -10,7 +10,7 @@ use chatter_stability::boundary::{BoundaryOptions, LobePoint, lobe_diagram};
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::zero_order::zoa_lobes;
 use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
-use plotters::style::{BLUE, GREEN, RGBColor};
+use plotters::style::BLUE;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -26,7 +26,7 @@ pub enum Method {
 }
 
 impl Method {
-    fn solver(self) -> Option<Discretization> {
+    pub fn solver(self) -> Option<Discretization> {
         match self {
             Method::Zoa => None,
             Method::Fdm => Some(Discretization::full()),
@@ -136,7 +136,7 @@ fn frf_csv(model: &ModalModel, f0: f64, f1: f64, points: usize, i: usize, j: usi
 }
 
 /// Default speed range: around the lobes of the dominant mode (lobe numbers ~1 to 10).
-fn default_speeds(model: &ModalModel) -> Vec<f64> {
+pub fn default_speeds(model: &ModalModel) -> Vec<f64> {
     let f = chatter_stability::boundary::dominant_mode_frequency_hz(model);
     let n = model.operation().delays_per_revolution() as f64;
     let max = (60.0 * f / n * 1.2).min(60_000.0);
@@ -164,7 +164,7 @@ pub fn compute_lobes(
     }
 }
 
-fn markers(obs: Option<&Observations>) -> Option<Markers> {
+pub fn markers(obs: Option<&Observations>) -> Option<Markers> {
     obs.map(|o| Markers {
         stable: o
             .cuts
@@ -260,77 +260,6 @@ pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Meth
     Ok(())
 }
 
-/// `chatter bands --kind geometric`.
-#[allow(clippy::too_many_arguments)]
-pub fn bands_geometric(
-    model_path: &Path,
-    method: Method,
-    speeds: Option<&str>,
-    offset_rpm: f64,
-    offset_mm: f64,
-    observations: Option<&Path>,
-    out: Option<&Path>,
-    plot: Option<&Path>,
-    quiet: bool,
-) -> Result<()> {
-    let (obs, lobes) = load_and_compute(model_path, method, speeds, observations, quiet)?;
-    let curve: Vec<(f64, f64)> = lobes
-        .iter()
-        .filter(|p| p.depth_m.is_finite())
-        .map(|p| (p.speed_rpm, p.depth_mm()))
-        .collect();
-    let bands = type_b_offsets(&curve, TypeBOffsets::new(offset_rpm, offset_mm)?)?;
-    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance\n");
-    for p in &bands.points {
-        let lo =
-            chatter_uncertainty::geometric::OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
-        let up =
-            chatter_uncertainty::geometric::OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
-        let fmt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{}",
-            p.speed_rpm,
-            p.depth_mm,
-            fmt(lo),
-            fmt(up),
-            p.theta_deg,
-            p.distance
-        );
-    }
-    emit(out, &csv)?;
-    if let Some(path) = plot {
-        let series = band_series(curve, &bands);
-        line_chart(
-            path,
-            "Type B offset boundaries",
-            "spindle speed (rpm)",
-            "depth (mm)",
-            &series,
-            markers(obs.as_ref()).as_ref(),
-        )?;
-    }
-    Ok(())
-}
-
-/// Mean boundary with its lower and upper offsets, for plotting.
-fn band_series(
-    curve: Vec<(f64, f64)>,
-    bands: &chatter_uncertainty::geometric::OffsetBoundaries,
-) -> [Series; 3] {
-    let line = |label: &str, points: Vec<(f64, f64)>, color: RGBColor| Series {
-        label: label.into(),
-        points,
-        color,
-        dashed: false,
-    };
-    [
-        line("mean boundary", curve, BLUE),
-        line("lower offset", bands.lower.clone(), RGBColor(200, 0, 0)),
-        line("upper offset", bands.upper.clone(), GREEN),
-    ]
-}
-
 /// `chatter demo`: the main job on the embedded examples, results into a folder.
 pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     use chatter_dynamics::examples;
@@ -387,7 +316,12 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         "Seed 001 milling example: zero-order lobes with Type B offsets",
         "spindle speed (rpm)",
         "axial depth (mm)",
-        &band_series(curve.clone(), &bands),
+        &crate::bands::band_series(
+            curve,
+            bands.lower.clone(),
+            bands.upper.clone(),
+            ["mean boundary", "lower offset", "upper offset"],
+        ),
         None,
     )?;
     written.push(path);

@@ -1,6 +1,7 @@
 //! `chatter`: stability lobes, multipliers, uncertainty bands and the demo, over the
 //! chatter-* crates. Thin by design: parse, call, write.
 
+mod bands;
 mod commands;
 mod inputs;
 mod output;
@@ -8,6 +9,7 @@ mod plot;
 mod progress;
 
 use clap::{Parser, Subcommand};
+use bands::BandKind;
 use commands::Method;
 use std::path::PathBuf;
 
@@ -104,27 +106,47 @@ enum Command {
         /// Model file.
         #[arg(long)]
         model: PathBuf,
-        /// Band kind (geometric: Type B offsets of seed 001).
+        /// Band kind: geometric (Type B offsets, seed 001), perturbation (second-order
+        /// credibility bounds, seed 000) or montecarlo (probability of stability, seed 004).
         #[arg(long, value_enum, default_value = "geometric")]
         kind: BandKind,
-        /// Stability method of the mean boundary.
-        #[arg(long, value_enum, default_value = "zoa")]
-        method: Method,
+        /// Stability method; default zoa for geometric, fdm otherwise.
+        #[arg(long, value_enum)]
+        method: Option<Method>,
         /// Speeds MIN:MAX:N (rpm).
         #[arg(long)]
         speeds: Option<String>,
-        /// Speed offset (rpm).
+        /// Depths MIN:MAX:N (mm) of the perturbation grid or the probability map; default 0 to
+        /// 1.5 times the deepest limit, 100 depths.
+        #[arg(long)]
+        depths: Option<String>,
+        /// Speed offset (rpm), geometric.
         #[arg(long, default_value_t = 100.0)]
         offset_rpm: f64,
-        /// Depth offset (mm).
+        /// Depth offset (mm), geometric.
         #[arg(long, default_value_t = 0.2)]
         offset_mm: f64,
+        /// Posterior folder of `chatter update` (summary.json, posterior.csv).
+        #[arg(long)]
+        posterior: Option<PathBuf>,
+        /// Covariance file: {"parameter_names": [...], "covariance": [[...]], "mean": [...]}.
+        #[arg(long)]
+        covariance: Option<PathBuf>,
+        /// Monte Carlo parameter samples.
+        #[arg(long, default_value_t = 500)]
+        samples: usize,
+        /// Seed of the Monte Carlo draws.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
         /// Observed cuts to draw.
         #[arg(long)]
         observations: Option<PathBuf>,
         /// Write the CSV here instead of stdout.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Monte Carlo: write the P_s map (speed_rpm,depth_mm,p_stable) here.
+        #[arg(long)]
+        map_out: Option<PathBuf>,
         /// SVG plot.
         #[arg(long)]
         plot: Option<PathBuf>,
@@ -184,13 +206,6 @@ enum QuantityArg {
     Displacement,
 }
 
-/// Band kinds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum BandKind {
-    /// Geometric Type B offsets (seed 001).
-    Geometric,
-}
-
 fn run(cli: Cli) -> anyhow::Result<()> {
     let quiet = cli.quiet;
     match cli.command {
@@ -246,25 +261,37 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         } => commands::multiplier(&model, speed_rpm, depth_mm, method),
         Command::Bands {
             model,
-            kind: BandKind::Geometric,
+            kind,
             method,
             speeds,
+            depths,
             offset_rpm,
             offset_mm,
+            posterior,
+            covariance,
+            samples,
+            seed,
             observations,
             out,
+            map_out,
             plot,
-        } => commands::bands_geometric(
-            &model,
+        } => bands::bands(&bands::BandRequest {
+            model: &model,
+            kind,
             method,
-            speeds.as_deref(),
-            offset_rpm,
-            offset_mm,
-            observations.as_deref(),
-            out.as_deref(),
-            plot.as_deref(),
+            speeds: speeds.as_deref(),
+            depths: depths.as_deref(),
+            offsets: (offset_rpm, offset_mm),
+            posterior: posterior.as_deref(),
+            covariance: covariance.as_deref(),
+            samples,
+            seed,
+            observations: observations.as_deref(),
+            out: out.as_deref(),
+            map_out: map_out.as_deref(),
+            plot: plot.as_deref(),
             quiet,
-        ),
+        }),
         Command::Simulate {
             model,
             speed_rpm,

@@ -20,6 +20,10 @@ impl Bar {
         bar.set_message(message.to_string());
         Self(bar)
     }
+    /// Set the position.
+    pub fn set(&self, done: usize) {
+        self.0.set_position(done as u64);
+    }
     /// Finish and clear.
     pub fn finish(&self) {
         self.0.finish_and_clear();

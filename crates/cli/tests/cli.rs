@@ -179,3 +179,114 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         .unwrap();
     assert_eq!(missing.status.code(), Some(1));
 }
+
+/// The Eq. 34 covariance of seed 000 as a covariance file (formats: README, `bands`).
+fn eq34_covariance(dir: &std::path::Path) -> PathBuf {
+    let path = dir.join("eq34.json");
+    std::fs::write(
+        &path,
+        r#"{"parameter_names": ["theta_omega_2", "theta_zeta_2", "theta_phi_2"],
+            "covariance": [[3.5e-7, -2.9e-5, -1.5e-5], [-2.9e-5, 0.0042, 0.0019], [-1.5e-5, 0.0019, 9.4e-4]]}"#,
+    )
+    .unwrap();
+    path
+}
+
+fn csv_rows(text: &str) -> Vec<Vec<Option<f64>>> {
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().ok()).collect())
+        .collect()
+}
+
+/// Perturbation bands of the turning case: lower <= mean <= upper where all exist, and the
+/// stable cut 7150 rpm / 2.286 mm lies below the lower bound (seed 000, Eq. 34).
+#[test]
+fn perturbation_bands_bracket_the_mean() {
+    let dir = tempfile::tempdir().unwrap();
+    let cov = eq34_covariance(dir.path());
+    let plot = dir.path().join("bands.svg");
+    let out = chatter()
+        .args([
+            "bands",
+            "--quiet",
+            "--kind",
+            "perturbation",
+            "--speeds",
+            "7150:7500:3",
+            "--depths",
+            "1.5:4:26",
+            "--covariance",
+        ])
+        .arg(&cov)
+        .arg("--model")
+        .arg(example("ahmadi2022_turning_model.json"))
+        .arg("--plot")
+        .arg(&plot)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm\n"), "{text}");
+    let rows = csv_rows(&text);
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        if let (Some(lo), Some(mean), Some(up)) = (r[2], r[1], r[3]) {
+            assert!(lo < mean && mean < up, "{r:?}");
+        }
+    }
+    assert!(rows[0][2].unwrap() > 2.286, "{:?}", rows[0]);
+    assert!(plot.exists());
+}
+
+/// Monte Carlo bands: quantile bounds ordered, the probability map written and within [0, 1];
+/// without a distribution the command fails with a message naming both options.
+#[test]
+fn montecarlo_bands_and_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let cov = eq34_covariance(dir.path());
+    let map = dir.path().join("map.csv");
+    let out = chatter()
+        .args([
+            "bands",
+            "--quiet",
+            "--kind",
+            "montecarlo",
+            "--samples",
+            "24",
+            "--seed",
+            "3",
+            "--speeds",
+            "7150:7500:2",
+            "--depths",
+            "1:4:7",
+            "--covariance",
+        ])
+        .arg(&cov)
+        .arg("--model")
+        .arg(example("ahmadi2022_turning_model.json"))
+        .arg("--map-out")
+        .arg(&map)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm,chatter_hz_q05"));
+    for r in csv_rows(&text) {
+        let (q50, q05, q95) = (r[1].unwrap(), r[2].unwrap(), r[3].unwrap());
+        assert!(q05 <= q50 && q50 <= q95, "{r:?}");
+    }
+    let grid = std::fs::read_to_string(&map).unwrap();
+    assert!(grid.starts_with("speed_rpm,depth_mm,p_stable\n"));
+    let rows = csv_rows(&grid);
+    assert_eq!(rows.len(), 2 * 7);
+    assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[2].unwrap())));
+    let out = chatter()
+        .args(["bands", "--kind", "montecarlo", "--model"])
+        .arg(example("ahmadi2022_turning_model.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("--posterior") && err.contains("--covariance"), "{err}");
+}

@@ -98,6 +98,40 @@ impl Discretization {
         }
     }
 
+    /// The same solver with the step count that [`StepsPerDelay::Auto`] picks for `model` at
+    /// `speed_rpm` made fixed, so that models perturbed around `model` (finite differences,
+    /// samplers) share one grid and their operators have the same dimension.
+    pub fn resolved(self, model: &ModalModel, speed_rpm: f64) -> Result<Self> {
+        let tau = model.operation().delay_s(speed_rpm);
+        let cutting_time: f64 = segments(model, speed_rpm, tau)
+            .iter()
+            .filter(|s| s.2)
+            .map(|s| s.1 - s.0)
+            .sum();
+        Ok(self.with_steps(self.cutting_steps(model, cutting_time)?))
+    }
+
+    /// Cutting steps per delay for a delay that cuts during `cutting_time` seconds.
+    fn cutting_steps(&self, model: &ModalModel, cutting_time: f64) -> Result<usize> {
+        match self.steps {
+            StepsPerDelay::Fixed(0) => Err(StabilityError::InvalidInput {
+                field: "steps_per_delay",
+                value: 0.0,
+                expected: "at least 1 step",
+            }),
+            StepsPerDelay::Fixed(m) => Ok(m),
+            StepsPerDelay::Auto => {
+                let f_max = model
+                    .modes()
+                    .iter()
+                    .map(|m| m.frequency_hz())
+                    .fold(0.0, f64::max);
+                Ok(AUTO_MIN_STEPS
+                    .max((AUTO_STEPS_PER_CYCLE * cutting_time * f_max).ceil() as usize))
+            }
+        }
+    }
+
     /// The monodromy operator at a cutting condition (depth in m).
     pub fn monodromy(&self, model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<Monodromy> {
         Monodromy::new(model, speed_rpm, depth_m, *self)
@@ -237,26 +271,7 @@ impl Monodromy {
         let tau = model.operation().delay_s(speed_rpm);
         let segs = segments(model, speed_rpm, tau);
         let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
-        let f_max = model
-            .modes()
-            .iter()
-            .map(|m| m.frequency_hz())
-            .fold(0.0, f64::max);
-        let m_cut = match method.steps {
-            StepsPerDelay::Fixed(m) => {
-                if m == 0 {
-                    return Err(StabilityError::InvalidInput {
-                        field: "steps_per_delay",
-                        value: 0.0,
-                        expected: "at least 1 step",
-                    });
-                }
-                m
-            }
-            StepsPerDelay::Auto => {
-                AUTO_MIN_STEPS.max((AUTO_STEPS_PER_CYCLE * cutting_time * f_max).ceil() as usize)
-            }
-        };
+        let m_cut = method.cutting_steps(model, cutting_time)?;
         // structural matrices
         let omegas = model.omegas_rad_s();
         let zetas = model.damping_ratios();
@@ -433,6 +448,55 @@ impl Monodromy {
         out[..s2].copy_from_slice(&y);
     }
 
+    /// Apply the transpose: `out` = U^T `x`, the reverse sweep of the step program of
+    /// [`Self::apply`] (each step y' = P y + R q_a + S q_b read backwards). Used for left
+    /// eigenvectors without forming U.
+    pub fn apply_transpose(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.modes;
+        let s2 = 2 * n;
+        out.fill(0.0);
+        let mut ybar = x[..s2].to_vec();
+        let mut prev = vec![0.0; s2];
+        for step in self.steps.iter().rev() {
+            if step.cutting {
+                let a = s2 + step.start * n;
+                // the delayed value at the end of the delay is the input displacement y_0
+                let b = if step.start + 1 == self.grid {
+                    0
+                } else {
+                    s2 + (step.start + 1) * n
+                };
+                for j in 0..n {
+                    let (mut ra, mut sb) = (0.0, 0.0);
+                    for (i, yi) in ybar.iter().enumerate() {
+                        ra += step.r[(i, j)] * yi;
+                        sb += step.s[(i, j)] * yi;
+                    }
+                    out[a + j] += ra;
+                    out[b + j] += sb;
+                }
+            }
+            for (j, pj) in prev.iter_mut().enumerate() {
+                *pj = ybar
+                    .iter()
+                    .enumerate()
+                    .map(|(i, yi)| step.p[(i, j)] * yi)
+                    .sum();
+            }
+            // the displacement at the step's start was stored as a delayed value
+            for (pj, xj) in prev
+                .iter_mut()
+                .zip(&x[s2 + step.start * n..s2 + (step.start + 1) * n])
+            {
+                *pj += xj;
+            }
+            std::mem::swap(&mut ybar, &mut prev);
+        }
+        for (o, yi) in out.iter_mut().zip(&ybar) {
+            *o += yi;
+        }
+    }
+
     /// The dense monodromy matrix (column by column).
     pub fn dense(&self) -> DMatrix<f64> {
         let d = self.dimension();
@@ -455,7 +519,7 @@ impl Monodromy {
         if d <= 24 {
             return largest(&self.dense().complex_eigenvalues());
         }
-        Ok(arnoldi(self, d)?.0)
+        Ok(arnoldi(|x, out| self.apply(x, out), d)?.0)
     }
 }
 
@@ -464,20 +528,19 @@ impl Monodromy {
     pub fn dominant_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
         let d = self.dimension();
         if d > 24 {
-            return arnoldi(self, d);
+            return arnoldi(|x, out| self.apply(x, out), d);
         }
-        let dense = self.dense();
-        let mu = largest(&dense.complex_eigenvalues())?;
-        let shift = mu * Complex64::new(1.0 + 1e-10, 0.0);
-        let lu = (dense.map(|x| Complex64::new(x, 0.0)) - DMatrix::identity(d, d) * shift).lu();
-        let mut x = DVector::from_element(d, Complex64::new(1.0, 0.0));
-        for _ in 0..3 {
-            if let Some(s) = lu.solve(&x) {
-                let nrm = s.norm();
-                x = s / Complex64::new(nrm, 0.0);
-            }
+        dense_eigenpair(self.dense())
+    }
+
+    /// The dominant eigenvalue and its left eigenvector v (U^T v = mu v), from the transposed
+    /// operator.
+    pub fn dominant_left_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
+        let d = self.dimension();
+        if d > 24 {
+            return arnoldi(|x, out| self.apply_transpose(x, out), d);
         }
-        Ok((mu, x.iter().copied().collect()))
+        dense_eigenpair(self.dense().transpose())
     }
 
     /// Chatter frequency (Hz) of the dominant eigenfunction: among the family f_mu + k / tau
@@ -528,6 +591,22 @@ impl Monodromy {
     }
 }
 
+/// Dominant eigenvalue of a small dense matrix and its eigenvector by inverse iteration.
+fn dense_eigenpair(dense: DMatrix<f64>) -> Result<(Complex64, Vec<Complex64>)> {
+    let d = dense.nrows();
+    let mu = largest(&dense.complex_eigenvalues())?;
+    let shift = mu * Complex64::new(1.0 + 1e-10, 0.0);
+    let lu = (dense.map(|x| Complex64::new(x, 0.0)) - DMatrix::identity(d, d) * shift).lu();
+    let mut x = DVector::from_element(d, Complex64::new(1.0, 0.0));
+    for _ in 0..3 {
+        if let Some(s) = lu.solve(&x) {
+            let nrm = s.norm();
+            x = s / Complex64::new(nrm, 0.0);
+        }
+    }
+    Ok((mu, x.iter().copied().collect()))
+}
+
 fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
     values
         .iter()
@@ -547,7 +626,9 @@ const ARNOLDI_RESTARTS: usize = 40;
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
 const ARNOLDI_TOL: f64 = 1e-10;
 
-fn arnoldi(op: &Monodromy, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
+/// Restarted Arnoldi for the eigenvalue of largest modulus of the operator `apply` of dimension
+/// `d`, with its Ritz vector.
+fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
     let k = ARNOLDI_DIM.min(d - 1);
     // deterministic start vector
     let mut start: Vec<f64> = (0..d)
@@ -564,7 +645,7 @@ fn arnoldi(op: &Monodromy, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
         let mut h = DMatrix::<f64>::zeros(k + 1, k);
         let mut kk = k;
         for j in 0..k {
-            op.apply(&v[j], &mut w);
+            apply(&v[j], &mut w);
             // modified Gram-Schmidt, twice for stability
             for _ in 0..2 {
                 for (i, vi) in v.iter().enumerate().take(j + 1) {
@@ -651,6 +732,37 @@ mod tests {
                     model.name(),
                     method.scheme
                 );
+            }
+        }
+    }
+
+    /// <U x, y> = <x, U^T y> to round-off, and the left eigenvalue equals the right one.
+    #[test]
+    fn transpose_is_the_adjoint() {
+        for (model, rpm, b) in [
+            (examples::insperger_benchmark(0.05), 12_000.0, 2.0e-3),
+            (examples::ahmadi_2022_turning(), 7150.0, 2.286e-3),
+        ] {
+            for method in [
+                Discretization::full().with_steps(30),
+                Discretization::semi().with_steps(30),
+            ] {
+                let op = method.monodromy(&model, rpm, b).unwrap();
+                let d = op.dimension();
+                let x: Vec<f64> = (0..d).map(|i| (0.3 * i as f64).sin()).collect();
+                let y: Vec<f64> = (0..d).map(|i| (0.7 * i as f64 + 1.0).cos()).collect();
+                let (mut ux, mut uty) = (vec![0.0; d], vec![0.0; d]);
+                op.apply(&x, &mut ux);
+                op.apply_transpose(&y, &mut uty);
+                let lhs: f64 = ux.iter().zip(&y).map(|(a, b)| a * b).sum();
+                let rhs: f64 = x.iter().zip(&uty).map(|(a, b)| a * b).sum();
+                assert!(
+                    (lhs - rhs).abs() < 1e-12 * lhs.abs().max(1.0),
+                    "{lhs} vs {rhs}"
+                );
+                let right = op.dominant_eigenvalue().unwrap();
+                let left = op.dominant_left_eigenpair().unwrap().0;
+                assert!((left.norm() - right.norm()).abs() < 1e-9 * right.norm());
             }
         }
     }

@@ -5,12 +5,14 @@
 //! - [`perturbation`]: second-order perturbation mean and variance of the dominant eigenvalue and
 //!   the credibility-bounded lobes (Ahmadi 2022, seed 000, Eq. 14-18).
 //! - [`montecarlo`]: probability-of-stability maps from parameter samples (seed 004, Fig. 2).
+//! - [`parameters`]: parameter distributions from covariance files and posterior folders.
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod error;
 pub mod geometric;
 pub mod montecarlo;
+pub mod parameters;
 pub mod perturbation;
 
 pub use error::{Result, UncertaintyError};

@@ -8,6 +8,13 @@
 //! distribution of the expected chatter frequency along speed.
 
 use crate::error::{Result, UncertaintyError};
+use chatter_dynamics::{ModalModel, Parameter};
+use chatter_stability::StabilitySolver;
+use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
+use nalgebra::{DMatrix, DVector};
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Per-sample limiting depths (and chatter frequencies) on a common speed grid.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,6 +151,85 @@ pub fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
     let h = (values.len() - 1) as f64 * q.clamp(0.0, 1.0);
     let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
     values[lo] + (h - lo as f64) * (values[hi] - values[lo])
+}
+
+/// One draw per sample of theta ~ N(`mean`, `covariance`), seeded: theta = mean + L z with L the
+/// Cholesky factor of the covariance and z standard normal. The draws do not depend on threads.
+pub fn gaussian_draws(
+    mean: &[f64],
+    covariance: &DMatrix<f64>,
+    samples: usize,
+    seed: u64,
+) -> Result<Vec<Vec<f64>>> {
+    let d = mean.len();
+    if covariance.shape() != (d, d) {
+        return Err(UncertaintyError::InvalidInput {
+            field: "covariance",
+            message: format!(
+                "a {d} x {d} matrix expected for {d} parameters, got {} x {}",
+                covariance.nrows(),
+                covariance.ncols()
+            ),
+        });
+    }
+    let l = covariance
+        .clone()
+        .cholesky()
+        .ok_or_else(|| UncertaintyError::InvalidInput {
+            field: "covariance",
+            message: "not symmetric positive definite".into(),
+        })?
+        .l();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    Ok((0..samples)
+        .map(|_| {
+            let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
+            let t = &l * z;
+            mean.iter().zip(t.iter()).map(|(m, t)| m + t).collect()
+        })
+        .collect())
+}
+
+/// The boundary of `model` perturbed by each parameter sample `thetas[s]` (see
+/// [`chatter_dynamics::ModalModel::perturbed`]) at every speed, in parallel over samples; the
+/// result does not depend on the thread count. `progress(done, total)` is called per sample.
+pub fn sample_boundaries<S: StabilitySolver + ?Sized>(
+    solver: &S,
+    model: &ModalModel,
+    parameters: &[Parameter],
+    thetas: &[Vec<f64>],
+    speeds_rpm: &[f64],
+    options: &BoundaryOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<SampledBoundaries> {
+    use rayon::prelude::*;
+    let done = AtomicUsize::new(0);
+    let rows = thetas
+        .par_iter()
+        .map(|theta| {
+            let m = model.perturbed(parameters, theta).map_err(|e| {
+                UncertaintyError::InvalidInput {
+                    field: "samples",
+                    message: e.to_string(),
+                }
+            })?;
+            let row = speeds_rpm
+                .iter()
+                .map(|&s| limiting_depth(solver, &m, s, options))
+                .collect::<std::result::Result<Vec<_>, _>>()?;
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, thetas.len());
+            Ok(row)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let limits = rows
+        .iter()
+        .map(|r| r.iter().map(|p| p.depth_mm()).collect())
+        .collect();
+    let hz = rows
+        .iter()
+        .map(|r| r.iter().map(|p| p.chatter_hz).collect())
+        .collect();
+    SampledBoundaries::new(speeds_rpm.to_vec(), limits, hz)
 }
 
 #[cfg(test)]

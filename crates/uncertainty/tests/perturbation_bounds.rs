@@ -4,7 +4,8 @@
 
 use chatter_dynamics::{Parameter, examples};
 use chatter_stability::monodromy::Discretization;
-use chatter_uncertainty::perturbation::model_moment_grid;
+use chatter_stability::sensitivity::eigenvalue_sensitivity;
+use chatter_uncertainty::perturbation::{EigenSensitivity, model_moment_grid, moments};
 use nalgebra::DMatrix;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -53,4 +54,48 @@ fn moments_match_monte_carlo_and_widen() {
     assert!((sd - m.std()).abs() < 0.15 * sd, "sd {sd} vs {}", m.std());
     let wide = model_moment_grid(method, &model, &params, &eq34, &[rpm], &[mm, 2.2]).unwrap();
     assert!(wide.moments[0][0].std() > m.std());
+}
+
+/// Seed 000, Section 6.4: with the posterior covariance of Eq. 34 every stable cut of Table 2
+/// lies below the lower credibility bound, i.e. |E mu| + sd(mu) < 1 there, for the nominal model
+/// and for the model at the posterior mean. The default (automatic) step count is used, so this
+/// also guards the sensitivity against a step count that changes with theta_omega of the
+/// highest mode.
+#[test]
+fn eq34_stable_cuts_lie_below_the_lower_bound() {
+    let model = examples::ahmadi_2022_turning();
+    let params: Vec<Parameter> = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"]
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let eq34 = DMatrix::from_row_slice(
+        3,
+        3,
+        &[
+            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
+        ],
+    );
+    let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549]).unwrap();
+    // Table 2 stable cuts (rpm, mm).
+    let stable = [
+        (7150.0, 2.286),
+        (7150.0, 2.54),
+        (6950.0, 2.54),
+        (7500.0, 2.032),
+        (7500.0, 2.54),
+    ];
+    for m in [&model, &updated] {
+        for &(rpm, mm) in &stable {
+            let s = eigenvalue_sensitivity(Discretization::full(), m, &params, rpm, mm * 1e-3)
+                .unwrap();
+            let sens = EigenSensitivity {
+                mu: s.mu,
+                gradient: s.gradient,
+                hessian: s.hessian,
+            };
+            let moments = moments(&sens, &eq34).unwrap();
+            let upper = moments.mean_modulus() + moments.std();
+            assert!(upper < 1.0, "{rpm} rpm {mm} mm: |E mu| + sd = {upper}");
+        }
+    }
 }

@@ -1,0 +1,331 @@
+//! `chatter bands`: geometric Type B offsets, perturbation credibility bounds and Monte Carlo
+//! probability-of-stability maps around the lobes.
+
+use crate::commands::{Method, compute_lobes, default_speeds, markers};
+use crate::output::{emit, write_atomic};
+use crate::plot::{Series, line_chart};
+use crate::{inputs, progress::Bar};
+use anyhow::{Result, bail};
+use chatter_dynamics::{ModalModel, Observations};
+use chatter_stability::boundary::{BoundaryOptions, LobePoint};
+use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
+use chatter_uncertainty::montecarlo::sample_boundaries;
+use chatter_uncertainty::parameters::ParameterDistribution;
+use chatter_uncertainty::perturbation::model_moment_grid;
+use plotters::style::{BLUE, GREEN, RGBColor};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Band kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BandKind {
+    /// Geometric Type B offsets (seed 001).
+    Geometric,
+    /// Second-order perturbation credibility bounds (seed 000 Eq. 14-18).
+    Perturbation,
+    /// Monte Carlo probability of stability (seed 004 Fig. 2).
+    Montecarlo,
+}
+
+/// Everything `chatter bands` was asked.
+pub struct BandRequest<'a> {
+    /// Model file.
+    pub model: &'a Path,
+    /// Band kind.
+    pub kind: BandKind,
+    /// Method; default zoa for geometric, fdm otherwise.
+    pub method: Option<Method>,
+    /// Speeds MIN:MAX:N.
+    pub speeds: Option<&'a str>,
+    /// Depths MIN:MAX:N (perturbation grid, Monte Carlo map).
+    pub depths: Option<&'a str>,
+    /// Type B offsets (rpm, mm).
+    pub offsets: (f64, f64),
+    /// Posterior folder.
+    pub posterior: Option<&'a Path>,
+    /// Covariance file.
+    pub covariance: Option<&'a Path>,
+    /// Monte Carlo samples.
+    pub samples: usize,
+    /// Seed of the Monte Carlo draws.
+    pub seed: u64,
+    /// Observed cuts.
+    pub observations: Option<&'a Path>,
+    /// CSV destination (stdout when absent).
+    pub out: Option<&'a Path>,
+    /// Probability map CSV (Monte Carlo).
+    pub map_out: Option<&'a Path>,
+    /// SVG plot.
+    pub plot: Option<&'a Path>,
+    /// No progress bars.
+    pub quiet: bool,
+}
+
+/// `chatter bands`.
+pub fn bands(req: &BandRequest) -> Result<()> {
+    let model = inputs::model(req.model)?;
+    let obs = req.observations.map(inputs::observations).transpose()?;
+    let speeds = match req.speeds {
+        Some(s) => inputs::speeds(s)?,
+        None => default_speeds(&model),
+    };
+    match req.kind {
+        BandKind::Geometric => geometric(req, &model, &speeds, obs.as_ref()),
+        BandKind::Perturbation => perturbation(req, &model, &speeds, obs.as_ref()),
+        BandKind::Montecarlo => montecarlo(req, &model, &speeds, obs.as_ref()),
+    }
+}
+
+fn finite_curve(lobes: &[LobePoint]) -> Vec<(f64, f64)> {
+    lobes
+        .iter()
+        .filter(|p| p.depth_m.is_finite())
+        .map(|p| (p.speed_rpm, p.depth_mm()))
+        .collect()
+}
+
+fn geometric(
+    req: &BandRequest,
+    model: &ModalModel,
+    speeds: &[f64],
+    obs: Option<&Observations>,
+) -> Result<()> {
+    let lobes = compute_lobes(model, req.method.unwrap_or(Method::Zoa), speeds, req.quiet)?;
+    let curve = finite_curve(&lobes);
+    let bands = type_b_offsets(&curve, TypeBOffsets::new(req.offsets.0, req.offsets.1)?)?;
+    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance\n");
+    for p in &bands.points {
+        let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
+        let up = OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{}",
+            p.speed_rpm,
+            p.depth_mm,
+            cell(lo),
+            cell(up),
+            p.theta_deg,
+            p.distance
+        );
+    }
+    emit(req.out, &csv)?;
+    if let Some(path) = req.plot {
+        let series = band_series(
+            curve,
+            bands.lower.clone(),
+            bands.upper.clone(),
+            ["mean boundary", "lower offset", "upper offset"],
+        );
+        line_chart(
+            path,
+            "Type B offset boundaries",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            markers(obs).as_ref(),
+        )?;
+    }
+    Ok(())
+}
+
+fn cell(v: Option<f64>) -> String {
+    v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// A mean boundary with a lower and an upper curve, for plotting.
+pub fn band_series(
+    mean: Vec<(f64, f64)>,
+    lower: Vec<(f64, f64)>,
+    upper: Vec<(f64, f64)>,
+    labels: [&str; 3],
+) -> [Series; 3] {
+    let line = |label: &str, points: Vec<(f64, f64)>, color: RGBColor| Series {
+        label: label.into(),
+        points,
+        color,
+        dashed: false,
+    };
+    [
+        line(labels[0], mean, BLUE),
+        line(labels[1], lower, RGBColor(200, 0, 0)),
+        line(labels[2], upper, GREEN),
+    ]
+}
+
+fn distribution(req: &BandRequest) -> Result<ParameterDistribution> {
+    Ok(match (req.posterior, req.covariance) {
+        (Some(dir), None) => ParameterDistribution::from_posterior_dir(dir)?,
+        (None, Some(file)) => ParameterDistribution::from_covariance_file(file)?,
+        (Some(_), Some(_)) => bail!("give either --posterior DIR or --covariance FILE, not both"),
+        (None, None) => bail!(
+            "--kind {:?} needs a parameter distribution: --posterior DIR (from `chatter update`) \
+             or --covariance FILE ({{\"parameter_names\": [...], \"covariance\": [[...]]}})",
+            req.kind
+        ),
+    })
+}
+
+fn discretization(req: &BandRequest) -> Result<chatter_stability::monodromy::Discretization> {
+    match req.method.unwrap_or(Method::Fdm).solver() {
+        Some(d) => Ok(d),
+        None => bail!("--kind {:?} needs --method fdm or sdm", req.kind),
+    }
+}
+
+/// Depth grid: `--depths` or 0 to 1.5 times the deepest finite limit, 100 points.
+fn depth_grid(req: &BandRequest, reference: &[LobePoint]) -> Result<Vec<f64>> {
+    if let Some(spec) = req.depths {
+        return inputs::grid("--depths", spec, 0.0);
+    }
+    let top = reference
+        .iter()
+        .map(|p| p.depth_mm())
+        .filter(|d| d.is_finite())
+        .fold(0.0, f64::max);
+    if top <= 0.0 {
+        bail!("no finite limiting depth over these speeds; give --depths MIN:MAX:N");
+    }
+    Ok((1..=100).map(|j| 1.5 * top * j as f64 / 100.0).collect())
+}
+
+fn perturbation(
+    req: &BandRequest,
+    model: &ModalModel,
+    speeds: &[f64],
+    obs: Option<&Observations>,
+) -> Result<()> {
+    let dist = distribution(req)?;
+    let method = discretization(req)?;
+    let mean_model = dist.mean_model(model)?;
+    let mean_lobes = compute_lobes(&mean_model, req.method.unwrap_or(Method::Fdm), speeds, true)?;
+    let depths = depth_grid(req, &mean_lobes)?;
+    let grid = model_moment_grid(
+        method,
+        &mean_model,
+        &dist.parameters,
+        &dist.covariance_about_mean(),
+        speeds,
+        &depths,
+    )?;
+    let bounds = grid.bounds();
+    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm\n");
+    for b in &bounds {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{}",
+            b.speed_rpm,
+            cell(b.depth_mm),
+            cell(b.lower_mm),
+            cell(b.upper_mm)
+        );
+    }
+    emit(req.out, &csv)?;
+    if let Some(path) = req.plot {
+        let pick = |f: fn(&chatter_uncertainty::perturbation::CredibilityPoint) -> Option<f64>| {
+            bounds
+                .iter()
+                .filter_map(|b| f(b).map(|d| (b.speed_rpm, d)))
+                .collect::<Vec<_>>()
+        };
+        let series = band_series(
+            pick(|b| b.depth_mm),
+            pick(|b| b.lower_mm),
+            pick(|b| b.upper_mm),
+            [
+                "mean |mu| = 1",
+                "|E mu| + sd = 1 (lower)",
+                "|E mu| - sd = 1 (upper)",
+            ],
+        );
+        line_chart(
+            path,
+            "Second-order perturbation credibility bounds",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            markers(obs).as_ref(),
+        )?;
+    }
+    Ok(())
+}
+
+fn montecarlo(
+    req: &BandRequest,
+    model: &ModalModel,
+    speeds: &[f64],
+    obs: Option<&Observations>,
+) -> Result<()> {
+    if req.samples < 2 {
+        bail!("--samples {}: at least 2 samples expected", req.samples);
+    }
+    let dist = distribution(req)?;
+    let method = discretization(req)?;
+    let thetas = dist.draws(req.samples, req.seed)?;
+    let bar = Bar::new(thetas.len() as u64, "Monte Carlo samples", req.quiet);
+    let sampled = sample_boundaries(
+        &method,
+        model,
+        &dist.parameters,
+        &thetas,
+        speeds,
+        &BoundaryOptions::default(),
+        &|done, _| bar.set(done),
+    )?;
+    bar.finish();
+    let depth = sampled.depth_bands();
+    let hz = sampled.chatter_frequency_bands();
+    let mut csv = String::from(
+        "speed_rpm,depth_mm,lower_mm,upper_mm,chatter_hz_q05,chatter_hz_q50,chatter_hz_q95\n",
+    );
+    for (d, f) in depth.iter().zip(&hz) {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{}",
+            d.speed_rpm, d.q50, d.q05, d.q95, f.q05, f.q50, f.q95
+        );
+    }
+    emit(req.out, &csv)?;
+    if let Some(path) = req.map_out {
+        let reference: Vec<LobePoint> = depth
+            .iter()
+            .map(|d| LobePoint {
+                speed_rpm: d.speed_rpm,
+                depth_m: d.q95 * 1e-3,
+                chatter_hz: f64::NAN,
+            })
+            .collect();
+        let depths = depth_grid(req, &reference)?;
+        let map = sampled.stability_map(&depths);
+        let mut text = String::from("speed_rpm,depth_mm,p_stable\n");
+        for (s, row) in map.speeds_rpm.iter().zip(&map.p_stable) {
+            for (b, p) in map.depths_mm.iter().zip(row) {
+                let _ = writeln!(text, "{s},{b},{p}");
+            }
+        }
+        write_atomic(path, text.as_bytes())?;
+    }
+    if let Some(path) = req.plot {
+        let curve = |f: fn(&chatter_uncertainty::montecarlo::QuantileBand) -> f64| {
+            depth
+                .iter()
+                .map(|d| (d.speed_rpm, f(d)))
+                .filter(|p| p.1.is_finite())
+                .collect::<Vec<_>>()
+        };
+        let series = band_series(
+            curve(|d| d.q50),
+            curve(|d| d.q05),
+            curve(|d| d.q95),
+            ["P_s = 0.5", "P_s = 0.95", "P_s = 0.05"],
+        );
+        line_chart(
+            path,
+            "Monte Carlo probability of stability",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            markers(obs).as_ref(),
+        )?;
+    }
+    Ok(())
+}

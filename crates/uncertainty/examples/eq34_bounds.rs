@@ -1,0 +1,51 @@
+//! Credibility-bounded limiting depths of the seed-000 turning case (Ahmadi 2022, Section 6.4):
+//! the posterior covariance of Eq. 34 propagated by the second-order perturbation of Eq. 14-18,
+//! for the nominal model and the model at the posterior mean.
+//!
+//! Run with `cargo run --release -p chatter-uncertainty --example eq34_bounds`.
+
+use chatter_dynamics::{Parameter, examples};
+use chatter_stability::monodromy::Discretization;
+use chatter_uncertainty::perturbation::model_moment_grid;
+use nalgebra::DMatrix;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let model = examples::ahmadi_2022_turning();
+    let params = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"]
+        .iter()
+        .map(|s| s.parse())
+        .collect::<Result<Vec<Parameter>, _>>()?;
+    // Eq. 34
+    let sigma = DMatrix::from_row_slice(
+        3,
+        3,
+        &[
+            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
+        ],
+    );
+    let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549])?;
+    let depths_mm: Vec<f64> = (0..=60).map(|j| 1.0 + 0.05 * f64::from(j)).collect();
+    let speeds_rpm = [6950.0, 7150.0, 7300.0, 7500.0];
+    let show = |x: Option<f64>| x.map_or_else(|| "> 4".to_string(), |v| format!("{v:.3}"));
+    println!("model,speed_rpm,lower_mm,depth_mm,upper_mm");
+    for (name, m) in [("nominal", &model), ("updated", &updated)] {
+        let grid = model_moment_grid(
+            Discretization::full(),
+            m,
+            &params,
+            &sigma,
+            &speeds_rpm,
+            &depths_mm,
+        )?;
+        for b in grid.bounds() {
+            println!(
+                "{name},{},{},{},{}",
+                b.speed_rpm,
+                show(b.lower_mm),
+                show(b.depth_mm),
+                show(b.upper_mm)
+            );
+        }
+    }
+    Ok(())
+}

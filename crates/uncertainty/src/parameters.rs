@@ -1,0 +1,253 @@
+//! Parameter distributions that feed the bands: a mean and covariance of named theta parameters
+//! (from a covariance file or a posterior's `summary.json`), optionally with posterior samples.
+//!
+//! Files (the toolkit's own, written by `chatter update` or by hand):
+//! - covariance file: `{"parameter_names": ["theta_omega_2", ...], "covariance": [[...], ...],
+//!   "mean": [...]}` (`mean` optional, zero by default);
+//! - posterior folder: `summary.json` with `parameter_names`, `posterior_mean` and
+//!   `posterior_covariance`, and optionally `posterior.csv` whose header names the parameters and
+//!   whose rows are samples.
+//!
+//! Names that are not model parameters (the error variance `sigma_r2`, say) are dropped with their
+//! rows and columns.
+
+use crate::error::{Result, UncertaintyError};
+use crate::montecarlo::gaussian_draws;
+use chatter_dynamics::{ModalModel, Parameter};
+use nalgebra::DMatrix;
+use std::path::Path;
+
+/// A distribution of named perturbation parameters theta (000 Eq. 12-13: omega(1 + theta) etc.).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterDistribution {
+    /// The parameters.
+    pub parameters: Vec<Parameter>,
+    /// Mean of theta.
+    pub mean: Vec<f64>,
+    /// Covariance of theta.
+    pub covariance: DMatrix<f64>,
+    /// Samples of theta (rows), when a posterior provides them.
+    pub samples: Option<Vec<Vec<f64>>>,
+}
+
+fn invalid(path: &Path, message: String) -> UncertaintyError {
+    UncertaintyError::InvalidInput {
+        field: "parameter distribution",
+        message: format!("{}: {message}", path.display()),
+    }
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CovarianceFile {
+    parameter_names: Vec<String>,
+    covariance: Vec<Vec<f64>>,
+    #[serde(default)]
+    mean: Option<Vec<f64>>,
+}
+
+#[derive(serde::Deserialize)]
+struct SummaryFile {
+    parameter_names: Vec<String>,
+    posterior_mean: Vec<f64>,
+    posterior_covariance: Vec<Vec<f64>>,
+}
+
+impl ParameterDistribution {
+    /// Validate shapes and keep only the model parameters among `names`.
+    pub fn new(
+        names: &[String],
+        mean: Vec<f64>,
+        covariance: Vec<Vec<f64>>,
+        samples: Option<Vec<Vec<f64>>>,
+        source: &Path,
+    ) -> Result<Self> {
+        let d = names.len();
+        if mean.len() != d {
+            return Err(invalid(
+                source,
+                format!("{d} parameter names but {} mean values", mean.len()),
+            ));
+        }
+        if covariance.len() != d || covariance.iter().any(|r| r.len() != d) {
+            return Err(invalid(
+                source,
+                format!("the covariance must be a {d} x {d} matrix (one row per parameter)"),
+            ));
+        }
+        if let Some(bad) = samples.as_ref().and_then(|s| s.iter().find(|r| r.len() != d)) {
+            return Err(invalid(
+                source,
+                format!("a sample has {} values, expected {d}", bad.len()),
+            ));
+        }
+        let keep: Vec<(usize, Parameter)> = names
+            .iter()
+            .enumerate()
+            .filter_map(|(i, n)| n.parse::<Parameter>().ok().map(|p| (i, p)))
+            .collect();
+        if keep.is_empty() {
+            return Err(invalid(
+                source,
+                format!(
+                    "none of the names {names:?} is a model parameter (theta_omega_N, \
+                     theta_zeta_N, theta_phi_N or theta_k_N)"
+                ),
+            ));
+        }
+        let idx: Vec<usize> = keep.iter().map(|k| k.0).collect();
+        let covariance = DMatrix::from_fn(idx.len(), idx.len(), |a, b| covariance[idx[a]][idx[b]]);
+        if covariance.clone().cholesky().is_none() {
+            return Err(invalid(
+                source,
+                "the covariance is not symmetric positive definite".into(),
+            ));
+        }
+        Ok(Self {
+            parameters: keep.iter().map(|k| k.1).collect(),
+            mean: idx.iter().map(|&i| mean[i]).collect(),
+            covariance,
+            samples: samples.map(|s| {
+                s.iter()
+                    .map(|r| idx.iter().map(|&i| r[i]).collect())
+                    .collect()
+            }),
+        })
+    }
+
+    /// Read a covariance file (see the module docs).
+    pub fn from_covariance_file(path: &Path) -> Result<Self> {
+        let text = read(path)?;
+        let f: CovarianceFile =
+            serde_json::from_str(&text).map_err(|e| invalid(path, e.to_string()))?;
+        let mean = f
+            .mean
+            .unwrap_or_else(|| vec![0.0; f.parameter_names.len()]);
+        Self::new(&f.parameter_names, mean, f.covariance, None, path)
+    }
+
+    /// Read a posterior folder: `summary.json` and, when present, `posterior.csv`.
+    pub fn from_posterior_dir(dir: &Path) -> Result<Self> {
+        let summary_path = dir.join("summary.json");
+        let text = read(&summary_path)?;
+        let s: SummaryFile =
+            serde_json::from_str(&text).map_err(|e| invalid(&summary_path, e.to_string()))?;
+        let csv_path = dir.join("posterior.csv");
+        let samples = if csv_path.exists() {
+            Some(read_samples(&csv_path, &s.parameter_names)?)
+        } else {
+            None
+        };
+        Self::new(
+            &s.parameter_names,
+            s.posterior_mean,
+            s.posterior_covariance,
+            samples,
+            &summary_path,
+        )
+    }
+
+    /// The model at the mean parameters.
+    pub fn mean_model(&self, nominal: &ModalModel) -> Result<ModalModel> {
+        nominal
+            .perturbed(&self.parameters, &self.mean)
+            .map_err(|e| UncertaintyError::InvalidInput {
+                field: "mean",
+                message: e.to_string(),
+            })
+    }
+
+    /// The covariance of theta' measured from the mean model instead of the nominal one. Every
+    /// parameter scales a nominal value by (1 + theta), so x_0 (1 + theta) = x_0 (1 + mean)
+    /// (1 + theta') gives theta' = (theta - mean) / (1 + mean): Sigma' = D Sigma D with
+    /// D = diag(1 / (1 + mean_i)).
+    pub fn covariance_about_mean(&self) -> DMatrix<f64> {
+        let d = DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(
+            self.mean.len(),
+            self.mean.iter().map(|m| 1.0 / (1.0 + m)),
+        ));
+        &d * &self.covariance * &d
+    }
+
+    /// `n` parameter draws: the posterior samples when present (cycled in order if `n` exceeds
+    /// them, every k-th when fewer are asked), else Gaussian draws of N(mean, covariance).
+    pub fn draws(&self, n: usize, seed: u64) -> Result<Vec<Vec<f64>>> {
+        match &self.samples {
+            Some(s) if !s.is_empty() => {
+                let stride = (s.len() / n.max(1)).max(1);
+                Ok((0..n).map(|i| s[(i * stride) % s.len()].clone()).collect())
+            }
+            _ => gaussian_draws(&self.mean, &self.covariance, n, seed),
+        }
+    }
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| invalid(path, format!("cannot read: {e}")))
+}
+
+/// Samples from a CSV whose header holds (at least) `names`, in that order of columns.
+fn read_samples(path: &Path, names: &[String]) -> Result<Vec<Vec<f64>>> {
+    let mut reader = csv::Reader::from_path(path).map_err(|e| invalid(path, e.to_string()))?;
+    let header = reader
+        .headers()
+        .map_err(|e| invalid(path, e.to_string()))?
+        .clone();
+    let columns: Vec<usize> = names
+        .iter()
+        .map(|n| {
+            header
+                .iter()
+                .position(|h| h == n)
+                .ok_or_else(|| invalid(path, format!("no column `{n}` in the header")))
+        })
+        .collect::<Result<_>>()?;
+    reader
+        .records()
+        .enumerate()
+        .map(|(row, rec)| {
+            let rec = rec.map_err(|e| invalid(path, e.to_string()))?;
+            columns
+                .iter()
+                .map(|&c| {
+                    rec.get(c)
+                        .and_then(|v| v.trim().parse::<f64>().ok())
+                        .ok_or_else(|| {
+                            invalid(path, format!("row {}: `{}` is not a number", row + 2, &header[c]))
+                        })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn drops_non_model_parameters_and_checks_shapes() {
+        let names = vec!["theta_omega_2".to_string(), "sigma_r2".into()];
+        let d = ParameterDistribution::new(
+            &names,
+            vec![0.01, 0.5],
+            vec![vec![1e-6, 0.0], vec![0.0, 1.0]],
+            Some(vec![vec![0.02, 0.3]]),
+            Path::new("x.json"),
+        )
+        .unwrap();
+        assert_eq!(d.parameters.len(), 1);
+        assert_eq!(d.mean, vec![0.01]);
+        assert_eq!(d.samples.as_ref().unwrap()[0], vec![0.02]);
+        // theta' = (theta - mean) / (1 + mean)
+        assert!((d.covariance_about_mean()[(0, 0)] - 1e-6 / 1.01f64.powi(2)).abs() < 1e-18);
+        let bad = ParameterDistribution::new(
+            &names,
+            vec![0.0],
+            vec![vec![1.0, 0.0], vec![0.0, 1.0]],
+            None,
+            Path::new("x.json"),
+        );
+        assert!(bad.unwrap_err().to_string().contains("x.json"));
+    }
+}
