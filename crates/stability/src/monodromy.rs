@@ -183,13 +183,12 @@ impl StabilitySolver for Discretization {
     }
 }
 
-/// One step of the program: y_{k+1} = P y_k + R q_a + S q_b where q_a, q_b are delayed grid
-/// values (indices into the delayed part of the state; `None` for free flight).
-#[derive(Debug, Clone)]
+/// One step of the program: y_{k+1} = P y_k + R q_a + S q_b where q_a, q_b are the delayed
+/// values at the step's start and end grid points. The blocks live in [`Monodromy::coefficients`]
+/// from `offset`: P (2N x 2N), then for cutting steps R and S (2N x N each), row-major.
+#[derive(Debug, Clone, Copy)]
 struct Step {
-    p: DMatrix<f64>,
-    r: DMatrix<f64>,
-    s: DMatrix<f64>,
+    offset: usize,
     /// Index of the grid point at the start of the step (its delayed value is R's input); the
     /// end point is `start + 1` (or y_0 when it equals the grid size).
     start: usize,
@@ -204,6 +203,9 @@ pub struct Monodromy {
     /// Grid points per delay M.
     grid: usize,
     steps: Vec<Step>,
+    /// Step blocks, row-major, one contiguous buffer (steps of constant-coefficient segments
+    /// share one block).
+    coefficients: Vec<f64>,
     /// Length (s) of the step leaving each grid point.
     step_s: Vec<f64>,
     /// The delay tau (s).
@@ -258,6 +260,148 @@ fn exp_integrals(a: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatr
     (phi0, f1, f2)
 }
 
+/// Row-major copy of a matrix.
+fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+    m.transpose().as_slice().to_vec()
+}
+
+/// The periodic coefficients at one time in modal coordinates: M = [b W | b P] (N x 2N,
+/// row-major), so that A(t) = [[0, 0], [-M]] and B(t) = [[0], [b W]].
+struct Periodic<'a> {
+    model: &'a ModalModel,
+    speed_rpm: f64,
+    depth_m: f64,
+    /// Phi (2 x N), row-major.
+    phi: Vec<f64>,
+    modes: usize,
+}
+
+impl Periodic<'_> {
+    fn at(&self, t: f64, m: &mut [f64]) {
+        let n = self.modes;
+        let h = self.model.directional_matrix(t, self.speed_rpm);
+        let d = self.model.process_damping_matrix(t, self.speed_rpm);
+        for p in 0..n {
+            for q in 0..n {
+                let (mut w, mut pd) = (0.0, 0.0);
+                for a in 0..2 {
+                    for c in 0..2 {
+                        let f = self.phi[a * n + p] * self.phi[c * n + q];
+                        w += f * h[(a, c)];
+                        pd += f * d[(a, c)];
+                    }
+                }
+                m[p * 2 * n + q] = self.depth_m * w;
+                m[p * 2 * n + n + q] = self.depth_m * pd;
+            }
+        }
+    }
+}
+
+/// Gaussian elimination with partial pivoting of the small system `a` x = `b` in place
+/// (`a` d x d, `b` d x k, row-major); `false` when `a` is singular.
+fn solve_small(a: &mut [f64], b: &mut [f64], d: usize, k: usize) -> bool {
+    for col in 0..d {
+        let pivot = (col..d)
+            .max_by(|&i, &j| a[i * d + col].abs().total_cmp(&a[j * d + col].abs()))
+            .unwrap_or(col);
+        if a[pivot * d + col] == 0.0 || !a[pivot * d + col].is_finite() {
+            return false;
+        }
+        if pivot != col {
+            for j in 0..d {
+                a.swap(col * d + j, pivot * d + j);
+            }
+            for j in 0..k {
+                b.swap(col * k + j, pivot * k + j);
+            }
+        }
+        let inv = 1.0 / a[col * d + col];
+        for i in col + 1..d {
+            let f = a[i * d + col] * inv;
+            if f == 0.0 {
+                continue;
+            }
+            for j in col..d {
+                a[i * d + j] -= f * a[col * d + j];
+            }
+            for j in 0..k {
+                b[i * k + j] -= f * b[col * k + j];
+            }
+        }
+    }
+    for col in (0..d).rev() {
+        let inv = 1.0 / a[col * d + col];
+        for j in 0..k {
+            let mut v = b[col * k + j];
+            for i in col + 1..d {
+                v -= a[col * d + i] * b[i * k + j];
+            }
+            b[col * k + j] = v * inv;
+        }
+    }
+    true
+}
+
+/// First-order full-discretization step (Ding et al. 2010) from the periodic coefficients at the
+/// step's start (`mi`) and end (`mj`): solves (I - F_2/h A_j) [P | R | S] =
+/// [e^{A_0 h} + C_1 A_i | C_1 B_i | F_2/h B_j] with C_1 = F_1 - F_2/h, appending P, R, S to
+/// `out`. `scratch` holds the (2N)^2 system and the 2N x 4N right-hand side.
+#[allow(clippy::too_many_arguments)]
+fn full_step(
+    n: usize,
+    phi0: &[f64],
+    c1: &[f64],
+    f2h: &[f64],
+    mi: &[f64],
+    mj: &[f64],
+    scratch: &mut (Vec<f64>, Vec<f64>),
+    out: &mut Vec<f64>,
+) -> bool {
+    let d = 2 * n;
+    let k = 4 * n;
+    let (lhs, rhs) = scratch;
+    lhs.clear();
+    lhs.resize(d * d, 0.0);
+    rhs.clear();
+    rhs.resize(d * k, 0.0);
+    for r in 0..d {
+        lhs[r * d + r] = 1.0;
+        for c in 0..d {
+            // only the lower block rows of A and B are non-zero: A = [[0], [-M]], B = [[0], [W]]
+            let (mut f2a, mut c1a) = (0.0, 0.0);
+            for q in 0..n {
+                f2a += f2h[r * d + n + q] * mj[q * d + c];
+                c1a += c1[r * d + n + q] * mi[q * d + c];
+            }
+            lhs[r * d + c] += f2a;
+            rhs[r * k + c] = phi0[r * d + c] - c1a;
+        }
+        for c in 0..n {
+            let (mut c1b, mut f2b) = (0.0, 0.0);
+            for q in 0..n {
+                c1b += c1[r * d + n + q] * mi[q * d + c];
+                f2b += f2h[r * d + n + q] * mj[q * d + c];
+            }
+            rhs[r * k + d + c] = c1b;
+            rhs[r * k + d + n + c] = f2b;
+        }
+    }
+    if !solve_small(lhs, rhs, d, k) {
+        return false;
+    }
+    // [P | R | S] row-major blocks
+    for r in 0..d {
+        out.extend_from_slice(&rhs[r * k..r * k + d]);
+    }
+    for block in [d, d + n] {
+        for r in 0..d {
+            out.extend_from_slice(&rhs[r * k + block..r * k + block + n]);
+        }
+    }
+    true
+}
+
 impl Monodromy {
     /// Build the step program at `speed_rpm`, depth `depth_m`.
     pub fn new(
@@ -268,6 +412,7 @@ impl Monodromy {
     ) -> Result<Self> {
         check_condition(speed_rpm, depth_m)?;
         let n = model.mode_count();
+        let d = 2 * n;
         let tau = model.operation().delay_s(speed_rpm);
         let segs = segments(model, speed_rpm, tau);
         let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
@@ -275,127 +420,114 @@ impl Monodromy {
         // structural matrices
         let omegas = model.omegas_rad_s();
         let zetas = model.damping_ratios();
-        let mut a0 = DMatrix::zeros(2 * n, 2 * n);
+        let mut a0 = DMatrix::zeros(d, d);
         for i in 0..n {
             a0[(i, n + i)] = 1.0;
             a0[(n + i, i)] = -omegas[i] * omegas[i];
             a0[(n + i, n + i)] = -2.0 * zetas[i] * omegas[i];
         }
-        let phi = model.shape_matrix();
-        let modal = |m2: nalgebra::Matrix2<f64>| -> DMatrix<f64> {
-            let m = DMatrix::from_fn(2, 2, |i, j| m2[(i, j)]);
-            phi.transpose() * m * &phi
+        let periodic = Periodic {
+            model,
+            speed_rpm,
+            depth_m,
+            phi: row_major(&model.shape_matrix()),
+            modes: n,
         };
-        // periodic part A(t) and B(t) at a time
-        let a_of = |t: f64| -> (DMatrix<f64>, DMatrix<f64>) {
-            let w = modal(model.directional_matrix(t, speed_rpm)) * depth_m;
-            let pd = modal(model.process_damping_matrix(t, speed_rpm)) * depth_m;
-            let mut a = DMatrix::zeros(2 * n, 2 * n);
-            a.view_mut((n, 0), (n, n)).copy_from(&(-&w));
-            a.view_mut((n, n), (n, n)).copy_from(&(-&pd));
-            let mut b = DMatrix::zeros(2 * n, n);
-            b.view_mut((n, 0), (n, n)).copy_from(&w);
-            (a, b)
-        };
-        let mut steps = Vec::new();
-        let mut step_s = Vec::new();
+        // constant coefficients (turning): every step of a segment is the same
+        let constant = matches!(model.operation(), Operation::Turning(_));
+        let mut steps = Vec::with_capacity(m_cut + segs.len());
+        let mut step_s = Vec::with_capacity(m_cut + segs.len());
+        let mut coefficients = Vec::new();
+        let mut scratch = (Vec::new(), Vec::new());
+        let (mut mi, mut mj) = (vec![0.0; n * d], vec![0.0; n * d]);
         let mut grid = 0usize;
         for &(start, end, cutting) in &segs {
             let len = end - start;
             if !cutting {
                 steps.push(Step {
-                    p: (&a0 * len).exp(),
-                    r: DMatrix::zeros(0, 0),
-                    s: DMatrix::zeros(0, 0),
+                    offset: coefficients.len(),
                     start: grid,
                     cutting: false,
                 });
+                coefficients.extend(row_major(&(&a0 * len).exp()));
                 step_s.push(len);
                 grid += 1;
                 continue;
             }
             let k = ((m_cut as f64 * len / cutting_time).round() as usize).max(1);
             let h = len / k as f64;
-            let (phi0, f1, f2) = match method.scheme {
-                Scheme::Full => exp_integrals(&a0, h),
-                Scheme::Semi => (
-                    DMatrix::zeros(0, 0),
-                    DMatrix::zeros(0, 0),
-                    DMatrix::zeros(0, 0),
-                ),
+            let full = match method.scheme {
+                Scheme::Full => {
+                    let (phi0, f1, f2) = exp_integrals(&a0, h);
+                    let f2h = &f2 / h;
+                    Some((row_major(&phi0), row_major(&(f1 - &f2h)), row_major(&f2h)))
+                }
+                Scheme::Semi => None,
             };
-            let mut carried: Option<(DMatrix<f64>, DMatrix<f64>)> = None;
-            // constant coefficients (turning): every step of the segment is the same
-            let constant = matches!(model.operation(), Operation::Turning(_));
             for i in 0..k {
                 let t0 = start + i as f64 * h;
                 if constant && i > 0 {
-                    let mut step = steps[steps.len() - 1].clone();
+                    let mut step = steps[steps.len() - 1];
                     step.start = grid;
                     steps.push(step);
                     step_s.push(h);
                     grid += 1;
                     continue;
                 }
-                let step = match method.scheme {
-                    Scheme::Full => {
-                        // products interpolated just inside the segment (H is smooth there)
+                let offset = coefficients.len();
+                match &full {
+                    Some((phi0, c1, f2h)) => {
+                        // products interpolated just inside the segment (H is smooth there); the
+                        // end of step i is the start of step i + 1 (same smooth segment)
                         let eps = 1e-9 * h;
-                        // the end of step i is the start of step i + 1 (same smooth segment)
-                        let (ai, bi) = match carried.take() {
-                            Some(x) => x,
-                            None => a_of(t0 + eps),
-                        };
-                        let (aj, bj) = a_of(t0 + h - eps);
-                        carried = Some((aj.clone(), bj.clone()));
-                        let lhs = DMatrix::identity(2 * n, 2 * n) - &f2 * &aj / h;
-                        let lu = lhs.lu();
-                        let c1 = &f1 - &f2 / h;
-                        let solve = |m: DMatrix<f64>| lu.solve(&m);
-                        let p = solve(&phi0 + &c1 * &ai);
-                        let r = solve(&c1 * &bi);
-                        let s = solve(&f2 * &bj / h);
-                        match (p, r, s) {
-                            (Some(p), Some(r), Some(s)) => Step {
-                                p,
-                                r,
-                                s,
-                                start: grid,
-                                cutting: true,
-                            },
-                            _ => {
-                                return Err(StabilityError::NoConvergence {
-                                    solver: "full discretization",
-                                    detail: format!("singular step matrix at t = {t0} s"),
-                                });
-                            }
+                        if i == 0 {
+                            periodic.at(t0 + eps, &mut mi);
+                        } else {
+                            std::mem::swap(&mut mi, &mut mj);
+                        }
+                        periodic.at(t0 + h - eps, &mut mj);
+                        if !full_step(n, phi0, c1, f2h, &mi, &mj, &mut scratch, &mut coefficients) {
+                            return Err(StabilityError::NoConvergence {
+                                solver: "full discretization",
+                                detail: format!("singular step matrix at t = {t0} s"),
+                            });
                         }
                     }
-                    Scheme::Semi => {
+                    None => {
                         // mean of the periodic part over the step (3-point Gauss)
                         let g = [
                             (0.5 - 0.5 * (0.6f64).sqrt(), 5.0 / 18.0),
                             (0.5, 8.0 / 18.0),
                             (0.5 + 0.5 * (0.6f64).sqrt(), 5.0 / 18.0),
                         ];
-                        let mut am = DMatrix::zeros(2 * n, 2 * n);
-                        let mut bm = DMatrix::zeros(2 * n, n);
+                        let mut mean = vec![0.0; n * d];
                         for (x, wgt) in g {
-                            let (a, b) = a_of(t0 + x * h);
-                            am += a * wgt;
-                            bm += b * wgt;
+                            periodic.at(t0 + x * h, &mut mi);
+                            for (a, b) in mean.iter_mut().zip(&mi) {
+                                *a += wgt * b;
+                            }
                         }
-                        let (e, f1, f2) = exp_integrals(&(&a0 + am), h);
-                        Step {
-                            p: e,
-                            r: (&f1 - &f2 / h) * &bm,
-                            s: &f2 / h * &bm,
-                            start: grid,
-                            cutting: true,
+                        let mut a = a0.clone();
+                        let mut bm = DMatrix::zeros(d, n);
+                        for p in 0..n {
+                            for c in 0..d {
+                                a[(n + p, c)] -= mean[p * d + c];
+                            }
+                            for c in 0..n {
+                                bm[(n + p, c)] = mean[p * d + c];
+                            }
                         }
+                        let (e, f1, f2) = exp_integrals(&a, h);
+                        coefficients.extend(row_major(&e));
+                        coefficients.extend(row_major(&((&f1 - &f2 / h) * &bm)));
+                        coefficients.extend(row_major(&(&f2 / h * &bm)));
                     }
-                };
-                steps.push(step);
+                }
+                steps.push(Step {
+                    offset,
+                    start: grid,
+                    cutting: true,
+                });
                 step_s.push(h);
                 grid += 1;
             }
@@ -404,6 +536,7 @@ impl Monodromy {
             modes: n,
             grid,
             steps,
+            coefficients,
             step_s,
             period_s: tau,
         })
@@ -414,34 +547,50 @@ impl Monodromy {
         2 * self.modes + self.modes * self.grid
     }
 
+    /// The blocks (P, R, S) of a step.
+    fn blocks(&self, step: &Step) -> (&[f64], &[f64], &[f64]) {
+        let d = 2 * self.modes;
+        let p = &self.coefficients[step.offset..step.offset + d * d];
+        if !step.cutting {
+            return (p, &[], &[]);
+        }
+        let dn = d * self.modes;
+        let r = &self.coefficients[step.offset + d * d..step.offset + d * d + dn];
+        let s = &self.coefficients[step.offset + d * d + dn..step.offset + d * d + 2 * dn];
+        (p, r, s)
+    }
+
     /// Apply the monodromy: `out` = U `x` (both of [`Self::dimension`]).
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
         let n = self.modes;
         let s2 = 2 * n;
         let mut y = x[..s2].to_vec();
         let mut next = vec![0.0; s2];
-        let delayed = |k: usize| -> &[f64] {
-            if k == self.grid {
-                &x[..n]
-            } else {
-                &x[s2 + k * n..s2 + (k + 1) * n]
-            }
-        };
         for step in &self.steps {
+            let a = s2 + step.start * n;
             // the new delayed value at this grid point is the current displacement
-            out[s2 + step.start * n..s2 + (step.start + 1) * n].copy_from_slice(&y[..n]);
+            out[a..a + n].copy_from_slice(&y[..n]);
+            let (p, r, s) = self.blocks(step);
             for (i, nx) in next.iter_mut().enumerate() {
-                let mut v = 0.0;
-                for (j, yj) in y.iter().enumerate() {
-                    v += step.p[(i, j)] * yj;
-                }
-                if step.cutting {
-                    let (qa, qb) = (delayed(step.start), delayed(step.start + 1));
+                *nx = p[i * s2..(i + 1) * s2]
+                    .iter()
+                    .zip(&y)
+                    .map(|(pij, yj)| pij * yj)
+                    .sum();
+            }
+            if step.cutting {
+                let qa = &x[a..a + n];
+                // the delayed value at the end of the delay is the input displacement y_0
+                let qb = if step.start + 1 == self.grid {
+                    &x[..n]
+                } else {
+                    &x[a + n..a + 2 * n]
+                };
+                for (i, nx) in next.iter_mut().enumerate() {
                     for j in 0..n {
-                        v += step.r[(i, j)] * qa[j] + step.s[(i, j)] * qb[j];
+                        *nx += r[i * n + j] * qa[j] + s[i * n + j] * qb[j];
                     }
                 }
-                *nx = v;
             }
             std::mem::swap(&mut y, &mut next);
         }
@@ -458,19 +607,19 @@ impl Monodromy {
         let mut ybar = x[..s2].to_vec();
         let mut prev = vec![0.0; s2];
         for step in self.steps.iter().rev() {
+            let a = s2 + step.start * n;
+            let (p, r, s) = self.blocks(step);
             if step.cutting {
-                let a = s2 + step.start * n;
-                // the delayed value at the end of the delay is the input displacement y_0
                 let b = if step.start + 1 == self.grid {
                     0
                 } else {
-                    s2 + (step.start + 1) * n
+                    a + n
                 };
                 for j in 0..n {
                     let (mut ra, mut sb) = (0.0, 0.0);
                     for (i, yi) in ybar.iter().enumerate() {
-                        ra += step.r[(i, j)] * yi;
-                        sb += step.s[(i, j)] * yi;
+                        ra += r[i * n + j] * yi;
+                        sb += s[i * n + j] * yi;
                     }
                     out[a + j] += ra;
                     out[b + j] += sb;
@@ -480,14 +629,11 @@ impl Monodromy {
                 *pj = ybar
                     .iter()
                     .enumerate()
-                    .map(|(i, yi)| step.p[(i, j)] * yi)
+                    .map(|(i, yi)| p[i * s2 + j] * yi)
                     .sum();
             }
             // the displacement at the step's start was stored as a delayed value
-            for (pj, xj) in prev
-                .iter_mut()
-                .zip(&x[s2 + step.start * n..s2 + (step.start + 1) * n])
-            {
+            for (pj, xj) in prev.iter_mut().zip(&x[a..a + n]) {
                 *pj += xj;
             }
             std::mem::swap(&mut ybar, &mut prev);
@@ -621,29 +767,61 @@ fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
 
 /// Krylov dimension of one Arnoldi cycle.
 const ARNOLDI_DIM: usize = 20;
+/// Krylov dimensions within a cycle at which convergence is tested (the small Hessenberg
+/// eigenproblem costs O(k^3), so most operators stop well before [`ARNOLDI_DIM`]).
+const ARNOLDI_CHECKS: [usize; 4] = [8, 12, 16, ARNOLDI_DIM];
 /// Maximum restarts.
 const ARNOLDI_RESTARTS: usize = 40;
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
 const ARNOLDI_TOL: f64 = 1e-10;
 
+/// The dominant Ritz pair of the leading kk x kk block of `h`: value, the small eigenvector and
+/// the residual estimate |h_{kk+1,kk} x_kk|.
+fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex64>, f64)> {
+    let hk = h.view((0, 0), (kk, kk)).into_owned();
+    let theta = largest(&hk.complex_eigenvalues())?;
+    // Ritz vector of theta by inverse iteration on the small Hessenberg matrix
+    let hc = hk.map(|x| Complex64::new(x, 0.0));
+    let shift = theta * Complex64::new(1.0 + 1e-10, 0.0);
+    let lu = (hc - DMatrix::identity(kk, kk) * shift).lu();
+    let mut x = DVector::from_element(kk, Complex64::new(1.0, 0.0));
+    for _ in 0..3 {
+        if let Some(s) = lu.solve(&x) {
+            let nrm = s.norm();
+            x = s / Complex64::new(nrm, 0.0);
+        }
+    }
+    let residual = if kk < h.nrows() {
+        h[(kk, kk - 1)] * x[kk - 1].norm()
+    } else {
+        0.0
+    };
+    Ok((theta, x, residual))
+}
+
 /// Restarted Arnoldi for the eigenvalue of largest modulus of the operator `apply` of dimension
-/// `d`, with its Ritz vector.
+/// `d`, with its Ritz vector. Convergence is tested at the Krylov dimensions of
+/// [`ARNOLDI_CHECKS`]; a cycle that reaches [`ARNOLDI_DIM`] restarts from its Ritz vector.
 fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
     let k = ARNOLDI_DIM.min(d - 1);
     // deterministic start vector
     let mut start: Vec<f64> = (0..d)
         .map(|i| 1.0 + 0.5 * ((i as f64) * 0.7).sin())
         .collect();
-    let mut previous: Option<(Complex64, Vec<Complex64>)> = None;
+    let mut previous: Option<Complex64> = None;
     let mut v = vec![vec![0.0; d]; k + 1];
     let mut w = vec![0.0; d];
+    let ritz_vector = |v: &[Vec<f64>], x: &DVector<Complex64>, kk: usize| -> Vec<Complex64> {
+        (0..d)
+            .map(|i| (0..kk).map(|j| x[j] * v[j][i]).sum())
+            .collect()
+    };
     for _ in 0..ARNOLDI_RESTARTS {
         let norm = start.iter().map(|x| x * x).sum::<f64>().sqrt();
         for (vi, si) in v[0].iter_mut().zip(&start) {
             *vi = si / norm;
         }
         let mut h = DMatrix::<f64>::zeros(k + 1, k);
-        let mut kk = k;
         for j in 0..k {
             apply(&v[j], &mut w);
             // modified Gram-Schmidt, twice for stability
@@ -658,48 +836,33 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
             }
             let beta = w.iter().map(|x| x * x).sum::<f64>().sqrt();
             h[(j + 1, j)] = beta;
-            if beta < 1e-14 {
-                kk = j + 1;
-                break;
+            let kk = j + 1;
+            let breakdown = beta < 1e-14;
+            if !breakdown {
+                for (vx, wx) in v[j + 1].iter_mut().zip(&w) {
+                    *vx = wx / beta;
+                }
             }
-            for (vx, wx) in v[j + 1].iter_mut().zip(&w) {
-                *vx = wx / beta;
+            if !(breakdown || kk == k || ARNOLDI_CHECKS.contains(&kk)) {
+                continue;
+            }
+            let (theta, x, residual) = ritz_pair(&h, kk)?;
+            let settled =
+                previous.is_some_and(|p| (p - theta).norm() <= 1e-3 * ARNOLDI_TOL * theta.norm());
+            if breakdown || residual <= ARNOLDI_TOL * theta.norm().max(1e-300) || settled {
+                return Ok((theta, ritz_vector(&v, &x, kk)));
+            }
+            if kk == k {
+                // restart from the real and imaginary parts of the Ritz vector combined
+                let ritz = ritz_vector(&v, &x, kk);
+                for (s, r) in start.iter_mut().zip(&ritz) {
+                    *s = r.re + r.im;
+                }
+                previous = Some(theta);
             }
         }
-        let hk = h.view((0, 0), (kk, kk)).into_owned();
-        let theta = largest(&hk.complex_eigenvalues())?;
-        // Ritz vector of theta by inverse iteration on the small Hessenberg matrix
-        let hc = hk.map(|x| Complex64::new(x, 0.0));
-        let shift = theta * Complex64::new(1.0 + 1e-10, 0.0);
-        let lu = (hc - DMatrix::identity(kk, kk) * shift).lu();
-        let mut x = DVector::from_element(kk, Complex64::new(1.0, 0.0));
-        for _ in 0..3 {
-            if let Some(s) = lu.solve(&x) {
-                let nrm = s.norm();
-                x = s / Complex64::new(nrm, 0.0);
-            }
-        }
-        let residual = if kk < h.nrows() {
-            h[(kk, kk - 1)] * x[kk - 1].norm()
-        } else {
-            0.0
-        };
-        let converged_prev = previous
-            .as_ref()
-            .is_some_and(|p| (p.0 - theta).norm() <= 1e-3 * ARNOLDI_TOL * theta.norm());
-        let ritz: Vec<Complex64> = (0..d)
-            .map(|i| (0..kk).map(|j| x[j] * v[j][i]).sum())
-            .collect();
-        if residual <= ARNOLDI_TOL * theta.norm().max(1e-300) || converged_prev || kk < k {
-            return Ok((theta, ritz));
-        }
-        // restart from the real and imaginary parts of the Ritz vector combined
-        for (s, r) in start.iter_mut().zip(&ritz) {
-            *s = r.re + r.im;
-        }
-        previous = Some((theta, ritz));
     }
-    previous.ok_or(StabilityError::NoConvergence {
+    Err(StabilityError::NoConvergence {
         solver: "Arnoldi",
         detail: format!("{ARNOLDI_RESTARTS} restarts"),
     })
