@@ -4,16 +4,17 @@
 //! With right and left eigenvectors u, v of the dominant eigenvalue mu, scaled so v^T u = 1,
 //!
 //! d mu / d theta_k = v^T G_k u                                                    (Eq. 15)
+//! d2 mu / d theta_i d theta_j = v^T G_ij u + v^T G_i w_j + v^T G_j w_i               (Eq. 16)
 //!
-//! G_k u is the central difference (step [`THETA_STEP`]) of the matrix-free products
-//! G(theta +- h e_k) u, and u, v come from restarted Arnoldi on U and U^T, so no dense matrix of
-//! the monodromy's dimension (2N + N M, about a thousand for the seed-000 turning case) is
-//! formed. The Hessian of Eq. 16 is the derivative of Eq. 15; it is evaluated as the central
-//! difference of the Eq. 15 gradient with step [`HESSIAN_STEP`] and symmetrized, which equals
-//! Eq. 16 (v^T G_ij u + v^T G_i w_j + v^T G_j w_i, w_j the reduced-resolvent term) to
-//! O(h^2) without the dense solve that w_j needs. Errors: O(THETA_STEP^2) ~ 1e-8 relative in
-//! the gradient, O(HESSIAN_STEP^2) ~ 1e-6 plus the Arnoldi tolerance over the step ~ 1e-7 in the
-//! Hessian.
+//! where w_j = sum_{r != m} u_r (v_r^T G_j u) / (mu - mu_r) is the sum of Eq. 16 over the other
+//! eigenpairs. It is computed without them as the reduced resolvent: the solution of
+//! (mu I - G) w_j = (I - u v^T) G_j u with v^T w_j = 0, by GMRES on the projected operator
+//! (I - u v^T)(mu I - G) (the projector commutes with G because u, v are eigenvectors).
+//!
+//! Nothing of the monodromy's dimension (2N + N M, about a thousand for the seed-000 turning
+//! case) is formed densely: u and v come from restarted Arnoldi on U and U^T, and G_k x, G_ij x
+//! are central differences (step [`THETA_STEP`]) of matrix-free products with the operators at
+//! theta +- h e_k (truncation O(h^2) ~ 1e-8 relative, round-off ~ 1e-16 / h^2 ~ 1e-8).
 
 use crate::error::{Result, StabilityError};
 use crate::monodromy::{Discretization, Monodromy};
@@ -21,10 +22,14 @@ use chatter_dynamics::{ModalModel, Parameter};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
-/// Finite-difference step in theta for G_k.
+/// Finite-difference step in theta.
 pub const THETA_STEP: f64 = 1e-4;
-/// Finite-difference step in theta for the Hessian (difference of gradients).
-pub const HESSIAN_STEP: f64 = 1e-3;
+/// Relative residual at which GMRES stops.
+const GMRES_TOL: f64 = 1e-11;
+/// Krylov dimension of one GMRES cycle.
+const GMRES_DIM: usize = 40;
+/// Maximum GMRES cycles.
+const GMRES_CYCLES: usize = 10;
 
 /// The dominant eigenvalue with its derivatives at theta = 0.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,70 +42,160 @@ pub struct EigenvalueSensitivity {
     pub hessian: DMatrix<Complex64>,
 }
 
-/// Operators of one cutting condition under perturbations theta of one model.
-struct Perturbed<'a> {
-    method: Discretization,
-    model: &'a ModalModel,
-    parameters: &'a [Parameter],
-    speed_rpm: f64,
-    depth_m: f64,
+type CVec = Vec<Complex64>;
+
+/// G x for a complex x (two real products).
+fn apply_complex(op: &Monodromy, x: &[Complex64]) -> CVec {
+    let d = x.len();
+    let (re, im): (Vec<f64>, Vec<f64>) = x.iter().map(|z| (z.re, z.im)).unzip();
+    let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
+    op.apply(&re, &mut a);
+    op.apply(&im, &mut b);
+    a.iter()
+        .zip(&b)
+        .map(|(x, y)| Complex64::new(*x, *y))
+        .collect()
 }
 
-impl Perturbed<'_> {
-    fn operator(&self, theta: &[f64]) -> Result<Monodromy> {
-        let m = self.model.perturbed(self.parameters, theta)?;
-        self.method.monodromy(&m, self.speed_rpm, self.depth_m)
-    }
+/// a^T b (no conjugation: the bilinear form of Eq. 15-16).
+fn dot(a: &[Complex64], b: &[Complex64]) -> Complex64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
 
-    /// mu (upper half-plane) with right and left eigenvectors scaled so v^T u = 1.
-    fn eigen(&self, theta: &[f64]) -> Result<(Complex64, Vec<Complex64>, Vec<Complex64>)> {
-        let op = self.operator(theta)?;
-        let upper = |(mu, x): (Complex64, Vec<Complex64>)| {
-            if mu.im < 0.0 {
-                (mu.conj(), x.iter().map(|z| z.conj()).collect())
-            } else {
-                (mu, x)
-            }
-        };
-        let (mu, u) = upper(op.dominant_eigenpair()?);
-        let (mu_left, v) = upper(op.dominant_left_eigenpair()?);
-        let scale: Complex64 = v.iter().zip(&u).map(|(a, b)| a * b).sum();
-        if (mu_left - mu).norm() > 1e-6 * mu.norm() || scale.norm() < 1e-300 {
-            return Err(StabilityError::NoConvergence {
-                solver: "eigenvalue sensitivity",
-                detail: format!(
-                    "left ({mu_left}) and right ({mu}) dominant eigenvalues differ: the dominant \
-                     eigenvalue is not simple here"
-                ),
-            });
+/// a^H b.
+fn inner(a: &[Complex64], b: &[Complex64]) -> Complex64 {
+    a.iter().zip(b).map(|(x, y)| x.conj() * y).sum()
+}
+
+fn norm(a: &[Complex64]) -> f64 {
+    a.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt()
+}
+
+/// mu (upper half-plane) with right and left eigenvectors scaled so v^T u = 1.
+fn eigen(op: &Monodromy) -> Result<(Complex64, CVec, CVec)> {
+    let upper = |(mu, x): (Complex64, CVec)| {
+        if mu.im < 0.0 {
+            (mu.conj(), x.iter().map(|z| z.conj()).collect())
+        } else {
+            (mu, x)
         }
-        Ok((mu, u, v.iter().map(|z| z / scale).collect()))
+    };
+    let (mu, u) = upper(op.dominant_eigenpair()?);
+    let (mu_left, v) = upper(op.dominant_left_eigenpair()?);
+    let scale = dot(&v, &u);
+    if (mu_left - mu).norm() > 1e-6 * mu.norm() || scale.norm() < 1e-300 {
+        return Err(StabilityError::NoConvergence {
+            solver: "eigenvalue sensitivity",
+            detail: format!(
+                "left ({mu_left}) and right ({mu}) dominant eigenvalues differ: the dominant \
+                 eigenvalue is not simple here"
+            ),
+        });
     }
+    Ok((mu, u, v.iter().map(|z| z / scale).collect()))
+}
 
-    /// Eq. 15 at theta.
-    fn gradient(&self, theta: &[f64]) -> Result<(Complex64, DVector<Complex64>)> {
-        let (mu, u, v) = self.eigen(theta)?;
-        let d = u.len();
-        let (ur, ui): (Vec<f64>, Vec<f64>) = u.iter().map(|z| (z.re, z.im)).unzip();
-        let mut gradient = DVector::zeros(theta.len());
-        let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
-        for k in 0..theta.len() {
-            let mut product = vec![Complex64::new(0.0, 0.0); d];
-            for (sign, step) in [(1.0, THETA_STEP), (-1.0, -THETA_STEP)] {
-                let mut t = theta.to_vec();
-                t[k] += step;
-                let op = self.operator(&t)?;
-                op.apply(&ur, &mut a);
-                op.apply(&ui, &mut b);
-                for ((p, x), y) in product.iter_mut().zip(&a).zip(&b) {
-                    *p += Complex64::new(sign * x, sign * y);
+/// The reduced resolvent: w with (mu I - G) w = r and v^T w = 0, for r with v^T r = 0, by
+/// restarted GMRES on x -> (I - u v^T)(mu x - G x).
+fn reduced_resolvent(
+    op: &Monodromy,
+    mu: Complex64,
+    u: &[Complex64],
+    v: &[Complex64],
+    r: &[Complex64],
+) -> Result<CVec> {
+    let d = r.len();
+    let project = |mut x: CVec| {
+        let c = dot(v, &x);
+        for (xi, ui) in x.iter_mut().zip(u) {
+            *xi -= c * ui;
+        }
+        x
+    };
+    let operator = |x: &[Complex64]| {
+        let gx = apply_complex(op, x);
+        project(x.iter().zip(&gx).map(|(a, b)| mu * a - b).collect())
+    };
+    let r_norm = norm(r);
+    let mut w = vec![Complex64::new(0.0, 0.0); d];
+    if r_norm == 0.0 {
+        return Ok(w);
+    }
+    let k = GMRES_DIM.min(d);
+    for _ in 0..GMRES_CYCLES {
+        let aw = operator(&w);
+        let res: CVec = r.iter().zip(&aw).map(|(a, b)| a - b).collect();
+        let beta = norm(&res);
+        if beta <= GMRES_TOL * r_norm {
+            return Ok(w);
+        }
+        let mut basis: Vec<CVec> = vec![res.iter().map(|z| z / beta).collect()];
+        let mut h = DMatrix::<Complex64>::zeros(k + 1, k);
+        // Givens rotations (c, s) and the rotated right-hand side g
+        let mut rot: Vec<(Complex64, Complex64)> = Vec::with_capacity(k);
+        let mut g = vec![Complex64::new(0.0, 0.0); k + 1];
+        g[0] = Complex64::new(beta, 0.0);
+        let mut used = 0;
+        for j in 0..k {
+            let mut q = operator(&basis[j]);
+            for _ in 0..2 {
+                for (i, b) in basis.iter().enumerate() {
+                    let c = inner(b, &q);
+                    h[(i, j)] += c;
+                    for (qx, bx) in q.iter_mut().zip(b) {
+                        *qx -= c * bx;
+                    }
                 }
             }
-            let vgu: Complex64 = v.iter().zip(&product).map(|(vi, pi)| vi * pi).sum();
-            gradient[k] = vgu / (2.0 * THETA_STEP);
+            let hn = norm(&q);
+            h[(j + 1, j)] = Complex64::new(hn, 0.0);
+            for (i, &(c, s)) in rot.iter().enumerate() {
+                let (a, b) = (h[(i, j)], h[(i + 1, j)]);
+                h[(i, j)] = c.conj() * a + s.conj() * b;
+                h[(i + 1, j)] = -s * a + c * b;
+            }
+            let (a, b) = (h[(j, j)], h[(j + 1, j)]);
+            let rr = (a.norm_sqr() + b.norm_sqr()).sqrt();
+            let (c, s) = if rr == 0.0 {
+                (Complex64::new(1.0, 0.0), Complex64::new(0.0, 0.0))
+            } else {
+                (a / rr, b / rr)
+            };
+            h[(j, j)] = Complex64::new(rr, 0.0);
+            h[(j + 1, j)] = Complex64::new(0.0, 0.0);
+            g[j + 1] = -s * g[j];
+            g[j] = c.conj() * g[j];
+            rot.push((c, s));
+            used = j + 1;
+            if g[j + 1].norm() <= GMRES_TOL * r_norm || hn < 1e-300 {
+                break;
+            }
+            basis.push(q.iter().map(|z| z / hn).collect());
         }
-        Ok((mu, gradient))
+        // back substitution of the triangular least-squares system
+        let mut y = vec![Complex64::new(0.0, 0.0); used];
+        for i in (0..used).rev() {
+            let mut t = g[i];
+            for (l, yl) in y.iter().enumerate().skip(i + 1) {
+                t -= h[(i, l)] * yl;
+            }
+            y[i] = t / h[(i, i)];
+        }
+        for (yi, b) in y.iter().zip(&basis) {
+            for (wx, bx) in w.iter_mut().zip(b) {
+                *wx += yi * bx;
+            }
+        }
     }
+    let aw = operator(&w);
+    let res = norm(&r.iter().zip(&aw).map(|(a, b)| a - b).collect::<CVec>());
+    if res <= 1e3 * GMRES_TOL * r_norm {
+        return Ok(w);
+    }
+    Err(StabilityError::NoConvergence {
+        solver: "reduced resolvent (GMRES)",
+        detail: format!("relative residual {:.1e}", res / r_norm),
+    })
 }
 
 /// Gradient and Hessian of the dominant eigenvalue (Eq. 15-16) at a cutting condition.
@@ -111,30 +206,65 @@ pub fn eigenvalue_sensitivity(
     speed_rpm: f64,
     depth_m: f64,
 ) -> Result<EigenvalueSensitivity> {
-    let problem = Perturbed {
-        // one grid for the nominal and every perturbed model
-        method: method.resolved(model, speed_rpm)?,
-        model,
-        parameters,
-        speed_rpm,
-        depth_m,
-    };
+    // one grid for the nominal and every perturbed model
+    let method = method.resolved(model, speed_rpm)?;
     let p = parameters.len();
-    let zero = vec![0.0; p];
-    let (mu, gradient) = problem.gradient(&zero)?;
+    let h = THETA_STEP;
+    let operator = |shifts: &[(usize, f64)]| -> Result<Monodromy> {
+        let mut theta = vec![0.0; p];
+        for &(i, s) in shifts {
+            theta[i] += s;
+        }
+        let m = model.perturbed(parameters, &theta)?;
+        method.monodromy(&m, speed_rpm, depth_m)
+    };
+    let g0 = operator(&[])?;
+    let (mu, u, v) = eigen(&g0)?;
+    let plus = (0..p)
+        .map(|i| operator(&[(i, h)]))
+        .collect::<Result<Vec<_>>>()?;
+    let minus = (0..p)
+        .map(|i| operator(&[(i, -h)]))
+        .collect::<Result<Vec<_>>>()?;
+    // G_k x by central differences
+    let first = |k: usize, x: &[Complex64]| -> CVec {
+        let (a, b) = (apply_complex(&plus[k], x), apply_complex(&minus[k], x));
+        a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+    };
+    let gu: Vec<CVec> = (0..p).map(|k| first(k, &u)).collect();
+    let gradient = DVector::from_fn(p, |k, _| dot(&v, &gu[k]));
+    let w = gu
+        .iter()
+        .map(|gj| {
+            let c = dot(&v, gj);
+            let rhs: CVec = gj.iter().zip(&u).map(|(a, b)| a - c * b).collect();
+            reduced_resolvent(&g0, mu, &u, &v, &rhs)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let u0 = apply_complex(&g0, &u);
     let mut hessian = DMatrix::zeros(p, p);
-    for j in 0..p {
-        let mut t = zero.clone();
-        t[j] = HESSIAN_STEP;
-        let plus = problem.gradient(&t)?.1;
-        t[j] = -HESSIAN_STEP;
-        let minus = problem.gradient(&t)?.1;
-        hessian.set_column(
-            j,
-            &((plus - minus) / Complex64::new(2.0 * HESSIAN_STEP, 0.0)),
-        );
+    for i in 0..p {
+        for j in i..p {
+            let gij_u: CVec = if i == j {
+                let (a, b) = (apply_complex(&plus[i], &u), apply_complex(&minus[i], &u));
+                (0..u.len())
+                    .map(|r| (a[r] - 2.0 * u0[r] + b[r]) / (h * h))
+                    .collect()
+            } else {
+                let mut acc = vec![Complex64::new(0.0, 0.0); u.len()];
+                for (si, sj, sign) in [(h, h, 1.0), (h, -h, -1.0), (-h, h, -1.0), (-h, -h, 1.0)] {
+                    let y = apply_complex(&operator(&[(i, si), (j, sj)])?, &u);
+                    for (a, b) in acc.iter_mut().zip(&y) {
+                        *a += sign * b / (4.0 * h * h);
+                    }
+                }
+                acc
+            };
+            let value = dot(&v, &gij_u) + dot(&v, &first(i, &w[j])) + dot(&v, &first(j, &w[i]));
+            hessian[(i, j)] = value;
+            hessian[(j, i)] = value;
+        }
     }
-    let hessian = (&hessian + hessian.transpose()) * Complex64::new(0.5, 0.0);
     Ok(EigenvalueSensitivity {
         mu,
         gradient,
