@@ -199,13 +199,38 @@ fn perturbation(
     let mean_model = dist.mean_model(model)?;
     let mean_lobes = compute_lobes(&mean_model, req.method.unwrap_or(Method::Fdm), speeds, true)?;
     let depths = depth_grid(req, &mean_lobes)?;
+    let (csv, series) = credibility_bands(&mean_model, &dist, method, speeds, &depths)?;
+    emit(req.out, &csv)?;
+    if let Some(path) = req.plot {
+        line_chart(
+            path,
+            "Second-order perturbation credibility bounds",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            markers(obs).as_ref(),
+        )?;
+    }
+    Ok(())
+}
+
+/// Credibility bounds of the model at the distribution's mean (000 Eq. 14-18 with the covariance
+/// about the mean) on a speed x depth grid: CSV `speed_rpm,depth_mm,lower_mm,upper_mm` and the
+/// plot series.
+pub fn credibility_bands(
+    mean_model: &ModalModel,
+    dist: &ParameterDistribution,
+    method: chatter_stability::monodromy::Discretization,
+    speeds: &[f64],
+    depths: &[f64],
+) -> Result<(String, [Series; 3])> {
     let grid = model_moment_grid(
         method,
-        &mean_model,
+        mean_model,
         &dist.parameters,
         &dist.covariance_about_mean(),
         speeds,
-        &depths,
+        depths,
     )?;
     let bounds = grid.bounds();
     let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm\n");
@@ -219,34 +244,23 @@ fn perturbation(
             cell(b.upper_mm)
         );
     }
-    emit(req.out, &csv)?;
-    if let Some(path) = req.plot {
-        let pick = |f: fn(&chatter_uncertainty::perturbation::CredibilityPoint) -> Option<f64>| {
-            bounds
-                .iter()
-                .filter_map(|b| f(b).map(|d| (b.speed_rpm, d)))
-                .collect::<Vec<_>>()
-        };
-        let series = band_series(
-            pick(|b| b.depth_mm),
-            pick(|b| b.lower_mm),
-            pick(|b| b.upper_mm),
-            [
-                "mean |mu| = 1",
-                "|E mu| + sd = 1 (lower)",
-                "|E mu| - sd = 1 (upper)",
-            ],
-        );
-        line_chart(
-            path,
-            "Second-order perturbation credibility bounds",
-            "spindle speed (rpm)",
-            "depth (mm)",
-            &series,
-            markers(obs).as_ref(),
-        )?;
-    }
-    Ok(())
+    let pick = |f: fn(&chatter_uncertainty::perturbation::CredibilityPoint) -> Option<f64>| {
+        bounds
+            .iter()
+            .filter_map(|b| f(b).map(|d| (b.speed_rpm, d)))
+            .collect::<Vec<_>>()
+    };
+    let series = band_series(
+        pick(|b| b.depth_mm),
+        pick(|b| b.lower_mm),
+        pick(|b| b.upper_mm),
+        [
+            "mean |mu| = 1",
+            "|E mu| + sd = 1 (lower)",
+            "|E mu| - sd = 1 (upper)",
+        ],
+    );
+    Ok((csv, series))
 }
 
 fn montecarlo(

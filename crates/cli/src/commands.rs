@@ -300,7 +300,50 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         serde_json::json!([at(6950.0), at(7150.0), at(7300.0), at(7500.0)]),
     );
 
-    // 2. Milling example of seed 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm).
+    // 2. Credibility bounds of the same case with the posterior covariance of Eq. 34 (written
+    //    out as a covariance file that `chatter bands --covariance` reads).
+    let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
+    let eq34 = vec![
+        vec![3.5e-7, -2.9e-5, -1.5e-5],
+        vec![-2.9e-5, 0.0042, 0.0019],
+        vec![-1.5e-5, 0.0019, 9.4e-4],
+    ];
+    let path = out_dir.join("eq34_covariance.json");
+    let file = serde_json::json!({"parameter_names": names, "covariance": eq34});
+    write_atomic(&path, serde_json::to_string_pretty(&file)?.as_bytes())?;
+    let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    let dist = chatter_uncertainty::parameters::ParameterDistribution::new(
+        &names,
+        vec![0.0; 3],
+        eq34,
+        None,
+        &path,
+    )?;
+    written.push(path);
+    let coarse: Vec<f64> = (0..=36).map(|i| 6800.0 + 25.0 * i as f64).collect();
+    let depths: Vec<f64> = (0..=60).map(|j| 1.0 + 0.05 * j as f64).collect();
+    let (csv, series) = crate::bands::credibility_bands(
+        &turning,
+        &dist,
+        chatter_stability::monodromy::Discretization::full(),
+        &coarse,
+        &depths,
+    )?;
+    let path = out_dir.join("turning_credibility.csv");
+    write_atomic(&path, csv.as_bytes())?;
+    written.push(path);
+    let path = out_dir.join("turning_credibility.svg");
+    line_chart(
+        &path,
+        "Seed 000 turning tool: credibility bounds with the Eq. 34 covariance",
+        "spindle speed (rpm)",
+        "width of cut (mm)",
+        &series,
+        markers(Some(&obs)).as_ref(),
+    )?;
+    written.push(path);
+
+    // 3. Milling example of seed 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm).
     let milling = examples::schmitz_2023_milling();
     let speeds: Vec<f64> = (0..=1000).map(|i| 4000.0 + 10.0 * i as f64).collect();
     let zoa = zoa_lobes(&milling, &speeds)?;

@@ -135,6 +135,9 @@ fn demo_writes_its_folder() {
         "turning_lobes.csv",
         "turning_lobes.svg",
         "milling_bands.svg",
+        "eq34_covariance.json",
+        "turning_credibility.csv",
+        "turning_credibility.svg",
         "summary.json",
     ] {
         assert!(dir.path().join(f).exists(), "{f} missing");
