@@ -1,0 +1,167 @@
+//! The posterior predictive check that decides whether the best class explains the data.
+//!
+//! For each observable type the discrepancy is the deviance T = -2 sum ln p(y_i | theta) of the
+//! labels, and the sum of squared standardized residuals of chatter frequencies, pole
+//! frequencies and pole damping ratios. Over posterior samples theta_s, the p-value is the
+//! posterior probability that replicated data are at least as discrepant: labels are
+//! replicated by drawing from each cut's chatter probability, and the Gaussian sums follow
+//! chi-square laws (Wilson-Hilferty). The best class fails when the smallest p-value is below the
+//! family-wise level divided by the number of observable types (Bonferroni).
+
+use crate::data::Dataset;
+use crate::likelihood::{NoiseModel, Prediction, folded, matched_pole};
+use chatter_bayes::prior::erfc;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use serde::Serialize;
+
+/// Label replications per posterior sample.
+const REPLICATES: usize = 40;
+
+/// The posterior predictive p-value of each observable type (None without such observations).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PredictiveCheck {
+    /// Cut labels (stable / chatter).
+    pub cut_labels: Option<f64>,
+    /// Chatter frequencies.
+    pub chatter_frequencies: Option<f64>,
+    /// Pole frequencies.
+    pub pole_frequencies: Option<f64>,
+    /// Pole damping ratios.
+    pub pole_damping: Option<f64>,
+    /// The family-wise level the smallest p-value is held to.
+    pub level: f64,
+    /// Whether the class explains the data at that level.
+    pub passed: bool,
+}
+
+/// Upper tail of the standard normal.
+fn upper_normal(z: f64) -> f64 {
+    0.5 * erfc(z / std::f64::consts::SQRT_2)
+}
+
+/// P(chi^2_n >= t) by the Wilson-Hilferty approximation.
+fn chi_square_tail(t: f64, n: usize) -> f64 {
+    let n = n as f64;
+    let v = 2.0 / (9.0 * n);
+    let z = ((t / n).cbrt() - (1.0 - v)) / v.sqrt();
+    upper_normal(z)
+}
+
+/// The check over posterior-sample predictions of `data`.
+pub(crate) fn predictive_check(
+    predictions: &[Prediction],
+    data: &Dataset,
+    noise: &NoiseModel,
+    level: f64,
+    seed: u64,
+) -> PredictiveCheck {
+    let mut label_p = Vec::new();
+    let mut chatter_p = Vec::new();
+    let mut pole_f_p = Vec::new();
+    let mut pole_z_p = Vec::new();
+    for (s, pred) in predictions.iter().enumerate() {
+        // labels: deviance of the data against replicated labels
+        if !data.cuts.is_empty() {
+            let q: Vec<f64> = data
+                .cuts
+                .iter()
+                .zip(&pred.cut_limit_m)
+                .map(|(c, b)| noise.chatter_probability((c.depth_m / b).ln()))
+                .collect();
+            let deviance = |unstable: &dyn Fn(usize) -> bool| -> f64 {
+                q.iter()
+                    .enumerate()
+                    .map(|(i, &p)| -2.0 * if unstable(i) { p.ln() } else { (1.0 - p).ln() })
+                    .sum()
+            };
+            let observed = deviance(&|i| !data.cuts[i].stable);
+            let mut rng =
+                StdRng::seed_from_u64(seed ^ (s as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+            let mut exceed = 0usize;
+            for _ in 0..REPLICATES {
+                let draws: Vec<bool> = q.iter().map(|&p| rng.random::<f64>() < p).collect();
+                if deviance(&|i| draws[i]) >= observed {
+                    exceed += 1;
+                }
+            }
+            label_p.push(exceed as f64 / REPLICATES as f64);
+        }
+        // chatter frequencies
+        let chatter: Vec<f64> = data
+            .cuts
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| {
+                let f = c.chatter_hz?;
+                let lobes = &pred.cut_lobes[i];
+                lobes
+                    .lobes()
+                    .filter(|(b, _)| *b <= c.depth_m.max(lobes.depth_m))
+                    .map(|(_, fc)| folded(f - fc, pred.cut_fold_hz[i]).abs())
+                    .min_by(f64::total_cmp)
+                    .map(|r| (r / data.chatter_std_hz).powi(2))
+            })
+            .collect();
+        if !chatter.is_empty() {
+            chatter_p.push(chi_square_tail(chatter.iter().sum(), chatter.len()));
+        }
+        if !data.poles.is_empty() {
+            let (mut tf, mut tz) = (0.0, 0.0);
+            for (i, p) in data.poles.iter().enumerate() {
+                match matched_pole(
+                    p.frequency_hz,
+                    p.damping_ratio,
+                    p.frequency_std_hz,
+                    p.damping_std,
+                    &pred.poles[i],
+                    pred.pole_fold_hz[i],
+                ) {
+                    Some((rf, rz)) => {
+                        tf += (rf / p.frequency_std_hz).powi(2);
+                        tz += (rz / p.damping_std).powi(2);
+                    }
+                    None => {
+                        tf += 100.0;
+                        tz += 100.0;
+                    }
+                }
+            }
+            pole_f_p.push(chi_square_tail(tf, data.poles.len()));
+            pole_z_p.push(chi_square_tail(tz, data.poles.len()));
+        }
+    }
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    let values = [
+        mean(&label_p),
+        mean(&chatter_p),
+        mean(&pole_f_p),
+        mean(&pole_z_p),
+    ];
+    let types = values.iter().flatten().count().max(1) as f64;
+    let smallest = values.iter().flatten().copied().fold(1.0, f64::min);
+    PredictiveCheck {
+        cut_labels: values[0],
+        chatter_frequencies: values[1],
+        pole_frequencies: values[2],
+        pole_damping: values[3],
+        level,
+        passed: smallest >= level / types,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chi_square_tail_is_close_to_exact() {
+        // chi^2_2 tail is exp(-t / 2)
+        for t in [0.5, 2.0, 6.0, 12.0] {
+            let exact = (-t / 2.0f64).exp();
+            assert!((chi_square_tail(t, 2) - exact).abs() < 0.02, "{t}");
+        }
+        // median of chi^2_30 is about 29.34
+        assert!((chi_square_tail(29.34, 30) - 0.5).abs() < 0.01);
+    }
+}

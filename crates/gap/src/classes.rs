@@ -1,0 +1,333 @@
+//! The candidate model classes: each is a parameterization of the nominal model with a prior.
+//!
+//! Every class recalibrates the nominal model with three factors (sampled as logarithms):
+//! all natural frequencies by s_f at constant modal stiffness, all damping ratios by s_zeta, and
+//! the cutting coefficients over the stiffness by g (the zero-order boundary and the poles
+//! depend on the cutting coefficients and the stiffness only through this ratio). The classes add:
+//!
+//! | class | extra parameters | prior |
+//! |---|---|---|
+//! | `parameter_error` | none | ln s_f ~ N(0, 0.05^2), ln s_zeta ~ N(0, 0.5^2), ln g ~ N(0, 0.3^2) |
+//! | `process_damping` | C in F_d = -C b ydot / V (003) | U(0, C_max), C_max: twice the structural damping added to the mode it acts on most, at the lowest observed speed and the lowest nominal limit |
+//! | `speed_dependent_dynamics` | c in f_n(Omega) = f_n0 (1 - c Omega^2), stiffness with f_n^2 | drop c Omega_max^2 ~ U(0, 0.2) |
+//! | `extra_mode` | frequency, damping, stiffness, direction of one more mode | ln(f / f_ref) ~ U(ln 0.4, ln 2.5), ln zeta ~ U(ln 0.005, ln 0.1), ln(k / k_ref) ~ U(ln 0.3, ln 30), angle ~ U(0, pi) |
+//! | `drift` | r in cutting coefficients x (1 + r u), u the campaign position from `sequence` | N(0, 0.5^2) truncated to [-0.8, 2] |
+//!
+//! f_ref and k_ref are the frequency and modal stiffness of the nominal mode that dominates
+//! regenerative chatter.
+
+use crate::data::Dataset;
+use crate::error::{GapError, Result};
+use crate::machine::{FastMode, Machine, geometries, quadratic};
+use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_dynamics::ModalModel;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Grid density of the models inside the samplers.
+const INFERENCE_DENSITY: usize = 1;
+/// C_max: the process damping that adds this many times a mode's structural damping at the
+/// lowest observed speed and the lowest nominal limiting depth, for the mode it acts on most.
+const PROCESS_DAMPING_SPAN: f64 = 2.0;
+/// Largest relative frequency drop at the highest observed speed.
+const MAX_SOFTENING: f64 = 0.2;
+
+/// A candidate explanation of the gap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EffectClass {
+    /// The nominal model recalibrated (frequencies, damping, cutting coefficients over stiffness).
+    ParameterError,
+    /// Recalibration plus process damping C (seed 003).
+    ProcessDamping,
+    /// Recalibration plus natural frequencies (and stiffness) falling with spindle speed.
+    SpeedDependentDynamics,
+    /// Recalibration plus one unmodelled mode.
+    ExtraMode,
+    /// Recalibration plus cutting coefficients changing linearly with `sequence`.
+    Drift,
+}
+
+impl EffectClass {
+    /// Every class, in report order.
+    pub const ALL: [EffectClass; 5] = [
+        EffectClass::ParameterError,
+        EffectClass::ProcessDamping,
+        EffectClass::SpeedDependentDynamics,
+        EffectClass::ExtraMode,
+        EffectClass::Drift,
+    ];
+
+    /// The name used in reports (`parameter_error`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            EffectClass::ParameterError => "parameter_error",
+            EffectClass::ProcessDamping => "process_damping",
+            EffectClass::SpeedDependentDynamics => "speed_dependent_dynamics",
+            EffectClass::ExtraMode => "extra_mode",
+            EffectClass::Drift => "drift",
+        }
+    }
+}
+
+impl std::fmt::Display for EffectClass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for EffectClass {
+    type Err = GapError;
+    /// A class from its report name.
+    fn from_str(s: &str) -> Result<Self> {
+        EffectClass::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| GapError::UnknownClass(s.to_string()))
+    }
+}
+
+/// The nominal model in fast form with the references the priors are scaled by.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Nominal {
+    pub machine: Machine,
+    /// Natural frequency of the dominant mode (Hz).
+    pub reference_hz: f64,
+    /// Modal stiffness of the dominant mode, omega^2 / |phi|^2 (N/m).
+    pub reference_stiffness_n_per_m: f64,
+    /// Highest observed speed (rpm).
+    pub max_speed_rpm: f64,
+    /// C_max of the process-damping prior; None without a cutting diameter.
+    pub process_damping_scale_n_per_m: Option<f64>,
+}
+
+impl Nominal {
+    /// The nominal model with the geometries of `immersions`; `speeds` are the observed speeds
+    /// (rpm) that scale the priors.
+    pub fn new(model: &ModalModel, immersions: &[Option<f64>], speeds: &[f64]) -> Result<Self> {
+        let machine =
+            Machine::from_model(model, geometries(model, immersions)?, INFERENCE_DENSITY)?;
+        let a = machine.geometries[0].directional;
+        let dominant = machine
+            .modes
+            .iter()
+            .copied()
+            .max_by(|x, y| weight(x, &a).total_cmp(&weight(y, &a)))
+            .ok_or_else(|| GapError::Model("no modes".into()))?;
+        let reference_hz = dominant.omega / (2.0 * PI);
+        let phi2 = dominant.phi[0].powi(2) + dominant.phi[1].powi(2);
+        let reference_stiffness_n_per_m = dominant.omega.powi(2) / phi2;
+        let max_speed_rpm = speeds.iter().copied().fold(0.0, f64::max);
+        let min_speed_rpm = speeds.iter().copied().fold(f64::INFINITY, f64::min);
+        if !(max_speed_rpm > 0.0 && min_speed_rpm.is_finite()) {
+            return Err(GapError::Observations("no spindle speeds".into()));
+        }
+        let process_damping_scale_n_per_m = match machine.diameter_m {
+            Some(d) => {
+                let mut bare = machine.clone();
+                bare.process_damping_n_per_m = 0.0;
+                let requests: Vec<(f64, usize)> = speeds.iter().map(|&s| (s, 0)).collect();
+                let b_min = bare
+                    .boundary(&requests)
+                    .iter()
+                    .map(|p| p.depth_m)
+                    .fold(f64::INFINITY, f64::min);
+                // the mode process damping acts on most, relative to its own damping
+                let v = PI * d * min_speed_rpm / 60.0;
+                let c = machine
+                    .modes
+                    .iter()
+                    .map(|m| {
+                        let q = quadratic(&machine.geometries[0].damping_per_cv, m.phi);
+                        PROCESS_DAMPING_SPAN * m.zeta * 2.0 * m.omega * v / (b_min * q)
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                (c.is_finite() && c > 0.0).then_some(c)
+            }
+            None => None,
+        };
+        Ok(Self {
+            machine,
+            reference_hz,
+            reference_stiffness_n_per_m,
+            max_speed_rpm,
+            process_damping_scale_n_per_m,
+        })
+    }
+}
+
+/// Oriented modal weight phi^T A phi / (zeta omega^2) of a mode (its share of chatter).
+fn weight(m: &FastMode, a: &[[f64; 2]; 2]) -> f64 {
+    quadratic(a, m.phi) / (m.zeta.max(1e-6) * m.omega * m.omega)
+}
+
+/// A class ready for the sampler: prior and the map from parameters to a machine.
+#[derive(Debug, Clone)]
+pub(crate) struct ClassModel<'a> {
+    pub class: EffectClass,
+    pub nominal: &'a Nominal,
+    pub prior: IndependentPrior,
+}
+
+/// Why a class cannot be tried on these data, or None.
+pub(crate) fn unavailable(class: EffectClass, nominal: &Nominal, data: &Dataset) -> Option<String> {
+    match class {
+        EffectClass::ProcessDamping if nominal.process_damping_scale_n_per_m.is_none() => Some(
+            "process_damping needs the cutting speed: give operation.tool_diameter_mm \
+             (milling) or operation.workpiece_diameter_mm (turning)"
+                .into(),
+        ),
+        EffectClass::Drift if !data.has_sequence => {
+            Some("drift needs `sequence` on every cut and pole (more than one value)".into())
+        }
+        _ => None,
+    }
+}
+
+impl<'a> ClassModel<'a> {
+    /// The class over `nominal`.
+    pub fn new(class: EffectClass, nominal: &'a Nominal) -> Result<Self> {
+        let mut m = vec![
+            Marginal::Normal {
+                mean: 0.0,
+                sd: 0.05,
+            },
+            Marginal::Normal { mean: 0.0, sd: 0.5 },
+            Marginal::Normal { mean: 0.0, sd: 0.3 },
+        ];
+        match class {
+            EffectClass::ParameterError => {}
+            EffectClass::ProcessDamping | EffectClass::SpeedDependentDynamics => {
+                m.push(Marginal::Uniform {
+                    low: 0.0,
+                    high: if class == EffectClass::ProcessDamping {
+                        1.0
+                    } else {
+                        MAX_SOFTENING
+                    },
+                });
+            }
+            EffectClass::ExtraMode => {
+                m.extend([
+                    Marginal::Uniform {
+                        low: 0.4f64.ln(),
+                        high: 2.5f64.ln(),
+                    },
+                    Marginal::Uniform {
+                        low: 0.005f64.ln(),
+                        high: 0.1f64.ln(),
+                    },
+                    Marginal::Uniform {
+                        low: 0.3f64.ln(),
+                        high: 30f64.ln(),
+                    },
+                    Marginal::Uniform { low: 0.0, high: PI },
+                ]);
+            }
+            EffectClass::Drift => m.push(Marginal::TruncatedNormal {
+                mean: 0.0,
+                sd: 0.5,
+                low: -0.8,
+                high: 2.0,
+            }),
+        }
+        let prior = IndependentPrior::new(m).map_err(|source| GapError::Sampler {
+            class: class.name(),
+            source,
+        })?;
+        Ok(Self {
+            class,
+            nominal,
+            prior,
+        })
+    }
+
+    /// The machine at parameters `theta`; None where they make no physical model.
+    pub fn machine(&self, theta: &[f64]) -> Option<Machine> {
+        let mut m = self.nominal.machine.clone();
+        let (sf, sz, g) = (theta[0].exp(), theta[1].exp(), theta[2].exp());
+        for mode in &mut m.modes {
+            mode.omega *= sf;
+            mode.phi = [mode.phi[0] * sf, mode.phi[1] * sf];
+            mode.zeta *= sz;
+            if mode.zeta >= 1.0 {
+                return None;
+            }
+        }
+        m.gain = g;
+        match self.class {
+            EffectClass::ParameterError => {}
+            EffectClass::ProcessDamping => {
+                m.process_damping_n_per_m =
+                    theta[3] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0);
+            }
+            EffectClass::SpeedDependentDynamics => {
+                m.softening_per_rpm2 = theta[3] / self.nominal.max_speed_rpm.powi(2);
+            }
+            EffectClass::ExtraMode => {
+                let omega = 2.0 * PI * self.nominal.reference_hz * theta[3].exp();
+                let k = self.nominal.reference_stiffness_n_per_m * theta[5].exp();
+                let amplitude = omega / k.sqrt();
+                m.modes.push(FastMode {
+                    omega,
+                    zeta: theta[4].exp(),
+                    phi: [amplitude * theta[6].cos(), amplitude * theta[6].sin()],
+                });
+            }
+            EffectClass::Drift => m.drift_rate = theta[3],
+        }
+        Some(m)
+    }
+
+    /// Reported parameters at `theta`: names with units and values.
+    pub fn physical(&self, theta: &[f64]) -> Vec<(&'static str, f64)> {
+        let mut out = vec![
+            ("frequency_factor", theta[0].exp()),
+            ("damping_factor", theta[1].exp()),
+            ("cutting_over_stiffness_factor", theta[2].exp()),
+        ];
+        match self.class {
+            EffectClass::ParameterError => {}
+            EffectClass::ProcessDamping => out.push((
+                "c_n_per_m",
+                theta[3] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0),
+            )),
+            EffectClass::SpeedDependentDynamics => {
+                out.push(("frequency_drop_at_max_speed", theta[3]));
+                out.push((
+                    "softening_per_rpm2",
+                    theta[3] / self.nominal.max_speed_rpm.powi(2),
+                ));
+            }
+            EffectClass::ExtraMode => {
+                let f = self.nominal.reference_hz * theta[3].exp();
+                out.push(("frequency_hz", f));
+                out.push(("damping_ratio", theta[4].exp()));
+                out.push((
+                    "stiffness_n_per_m",
+                    self.nominal.reference_stiffness_n_per_m * theta[5].exp(),
+                ));
+                out.push(("direction_deg", theta[6].to_degrees()));
+            }
+            EffectClass::Drift => out.push(("cutting_change_over_campaign", theta[3])),
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for c in EffectClass::ALL {
+            assert_eq!(c.name().parse::<EffectClass>().unwrap(), c);
+            assert_eq!(
+                serde_json::to_string(&c).unwrap(),
+                format!("\"{}\"", c.name())
+            );
+        }
+        assert!("runout".parse::<EffectClass>().is_err());
+    }
+}

@@ -1,0 +1,529 @@
+//! Bayesian model-class selection between the candidate effects, the verdict and the report.
+
+use crate::check::{PredictiveCheck, predictive_check};
+use crate::classes::{ClassModel, EffectClass, Nominal, unavailable};
+use crate::data::Dataset;
+use crate::error::{GapError, Result};
+use crate::likelihood::{NoiseModel, Prediction, predict, terms};
+use crate::machine::Machine;
+use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
+use crate::shrink::{Shrink, ValidationReport, shrink};
+use chatter_bayes::Prior;
+use chatter_bayes::tmcmc::{
+    Silent, TmcmcOptions, TmcmcResult, Variant, class_probabilities, tmcmc,
+};
+use chatter_dynamics::{ModalModel, Observations};
+use rayon::prelude::*;
+use serde::{Serialize, Serializer};
+use std::collections::BTreeMap;
+
+/// Posterior samples used by the predictive check and the posterior predictive densities.
+pub(crate) const PREDICTIVE_SAMPLES: usize = 100;
+
+/// Options of a diagnosis. Defaults in [`DiagnoseOptions::default`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiagnoseOptions {
+    /// Seed of every random choice (samplers, folds, replications).
+    pub seed: u64,
+    /// iTMCMC samples per class.
+    pub samples: usize,
+    /// Metropolis-Hastings steps per chain and stage.
+    pub steps: usize,
+    /// Burn-in steps per chain and stage.
+    pub burn_in: usize,
+    /// The observation noise.
+    pub noise: NoiseModel,
+    /// Family-wise level of the posterior predictive check below which the verdict is
+    /// `unexplained`.
+    pub check_level: f64,
+    /// The ln Bayes factor over `parameter_error` an effect class needs to be named (below it
+    /// plain recalibration explains the data as well and wins).
+    pub min_log_bayes_factor: f64,
+    /// Held-out validation of the gap's shrinkage.
+    pub validation: Validation,
+    /// iTMCMC samples per class and fold of the validation.
+    pub validation_samples: usize,
+    /// The candidate classes (`parameter_error` is always added).
+    pub classes: Vec<EffectClass>,
+}
+
+impl Default for DiagnoseOptions {
+    /// Seed 0, 250 samples, 2 steps after 1 burn-in step, the default noise, level 0.01, an
+    /// effect named from a Bayes factor of 3 over recalibration ("positive" evidence, Kass and
+    /// Raftery), 5-fold validation with 150 samples, every class.
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            samples: 250,
+            steps: 2,
+            burn_in: 1,
+            noise: NoiseModel::default(),
+            check_level: 0.01,
+            min_log_bayes_factor: 3f64.ln(),
+            validation: Validation::KFold { folds: 5 },
+            validation_samples: 150,
+            classes: EffectClass::ALL.to_vec(),
+        }
+    }
+}
+
+impl DiagnoseOptions {
+    fn validated(&self) -> Result<Self> {
+        let bad = |field: &str, value: f64, expected| {
+            Err(GapError::InvalidInput {
+                field: field.into(),
+                value,
+                expected,
+            })
+        };
+        if self.samples < 50 {
+            return bad("samples", self.samples as f64, ">= 50 samples per class");
+        }
+        if self.steps == 0 {
+            return bad("steps", 0.0, ">= 1 step");
+        }
+        if !(self.check_level > 0.0 && self.check_level < 1.0) {
+            return bad("check_level", self.check_level, "a level in (0, 1)");
+        }
+        if !(self.min_log_bayes_factor >= 0.0 && self.min_log_bayes_factor.is_finite()) {
+            return bad(
+                "min_log_bayes_factor",
+                self.min_log_bayes_factor,
+                "a finite ln Bayes factor >= 0",
+            );
+        }
+        match self.validation {
+            Validation::KFold { folds } | Validation::SpeedBands { bands: folds } if folds < 2 => {
+                return bad("validation folds", folds as f64, ">= 2 folds or bands");
+            }
+            _ => {}
+        }
+        if self.validation != Validation::Off && self.validation_samples < 50 {
+            return bad(
+                "validation_samples",
+                self.validation_samples as f64,
+                ">= 50 samples",
+            );
+        }
+        let mut out = self.clone();
+        out.noise = self.noise.validated()?;
+        if !out.classes.contains(&EffectClass::ParameterError) {
+            out.classes.insert(0, EffectClass::ParameterError);
+        }
+        out.classes.sort();
+        out.classes.dedup();
+        Ok(out)
+    }
+
+    pub(crate) fn tmcmc(&self, samples: usize, seed: u64) -> TmcmcOptions {
+        TmcmcOptions {
+            samples,
+            steps: self.steps,
+            burn_in: self.burn_in,
+            variant: Variant::Improved,
+            seed,
+            ..TmcmcOptions::default()
+        }
+    }
+}
+
+/// How the held-out shrinkage of the gap is measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Validation {
+    /// k folds of randomly assigned observations.
+    KFold {
+        /// Number of folds.
+        folds: usize,
+    },
+    /// Leave one speed band out: the distinct speeds split into contiguous bands.
+    SpeedBands {
+        /// Number of bands.
+        bands: usize,
+    },
+    /// No held-out validation.
+    Off,
+}
+
+/// Progress of a diagnosis; no-op by default.
+pub trait DiagnosisObserver: Sync {
+    /// A class's evidence is known.
+    fn class_done(&self, _class: EffectClass, _log_evidence: f64) {}
+    /// A validation fold is done.
+    fn fold_done(&self, _done: usize, _total: usize) {}
+}
+
+/// The observer that does nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Quiet;
+impl DiagnosisObserver for Quiet {}
+
+/// The verdict: the class that explains the gap, or none of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The best class passes the predictive check.
+    Class(EffectClass),
+    /// The best class still leaves residuals inconsistent with the noise.
+    Unexplained,
+}
+
+impl Verdict {
+    /// `parameter_error`, ..., or `unexplained`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Class(c) => c.name(),
+            Verdict::Unexplained => "unexplained",
+        }
+    }
+}
+
+impl Serialize for Verdict {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// Posterior mean and standard deviation of a parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ParameterSummary {
+    /// Posterior mean.
+    pub mean: f64,
+    /// Posterior standard deviation.
+    pub sd: f64,
+}
+
+/// One candidate class's result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ClassReport {
+    /// Class name.
+    pub name: EffectClass,
+    /// ln p(D | class) by iTMCMC.
+    pub log_evidence: f64,
+    /// Posterior probability among the tried classes (equal prior probabilities).
+    pub probability: f64,
+    /// Posterior mean log-likelihood (data fit).
+    pub data_fit: f64,
+    /// Data fit minus log evidence (information gained from the data).
+    pub information_gain: f64,
+    /// Posterior summaries of the physical parameters.
+    pub parameters: BTreeMap<String, ParameterSummary>,
+}
+
+/// A fitted class: the sampler's result and the map to machines.
+pub(crate) struct Fitted<'a> {
+    pub model: ClassModel<'a>,
+    pub run: TmcmcResult,
+}
+
+impl Fitted<'_> {
+    /// Up to `n` posterior samples, evenly thinned.
+    pub fn thinned(&self, n: usize) -> Vec<&[f64]> {
+        let s = self.run.samples.samples();
+        let step = (s.len() / n.max(1)).max(1);
+        s.iter().step_by(step).take(n).map(Vec::as_slice).collect()
+    }
+
+    /// The highest-posterior sample's machine.
+    pub fn mode_machine(&self) -> Option<Machine> {
+        let s = self.run.samples.samples();
+        let best = s
+            .iter()
+            .zip(&self.run.ln_likelihoods)
+            .map(|(t, l)| (t, l + self.model.prior.ln_pdf(t)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        self.model.machine(best.0)
+    }
+}
+
+/// The log-likelihood of `data` for a class at `theta`.
+pub(crate) fn log_likelihood(
+    model: &ClassModel,
+    data: &Dataset,
+    noise: &NoiseModel,
+    theta: &[f64],
+) -> f64 {
+    match model.machine(theta) {
+        Some(m) => {
+            let v = terms(&predict(&m, data), data, noise).total();
+            if v.is_nan() { f64::NEG_INFINITY } else { v }
+        }
+        None => f64::NEG_INFINITY,
+    }
+}
+
+/// Fit one class to `data` by iTMCMC.
+pub(crate) fn fit<'a>(
+    class: EffectClass,
+    nominal: &'a Nominal,
+    data: &Dataset,
+    options: &DiagnoseOptions,
+    samples: usize,
+    seed: u64,
+) -> Result<Fitted<'a>> {
+    let model = ClassModel::new(class, nominal)?;
+    let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta);
+    let run =
+        tmcmc(&model.prior, &like, &options.tmcmc(samples, seed), &Silent).map_err(|source| {
+            GapError::Sampler {
+                class: class.name(),
+                source,
+            }
+        })?;
+    Ok(Fitted { model, run })
+}
+
+/// Predictions of the thinned posterior samples.
+pub(crate) fn posterior_predictions(fitted: &Fitted, data: &Dataset) -> Vec<Prediction> {
+    fitted
+        .thinned(PREDICTIVE_SAMPLES)
+        .par_iter()
+        .filter_map(|t| fitted.model.machine(t).map(|m| predict(&m, data)))
+        .collect()
+}
+
+/// Seed of a class's sampler.
+pub(crate) fn class_seed(seed: u64, class: EffectClass, fold: usize) -> u64 {
+    seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (class as u64 + 1).wrapping_mul(0xBF58_476D_1CE4_E5B9)
+        ^ (fold as u64).wrapping_mul(0x94D0_49BB_1331_11EB)
+}
+
+/// The prepared inputs of a diagnosis.
+pub(crate) struct Prepared {
+    pub nominal: Nominal,
+    pub data: Dataset,
+}
+
+/// Validate the inputs and prepare the nominal model and the data.
+pub(crate) fn prepare(
+    model: &ModalModel,
+    observations: &Observations,
+    noise: &NoiseModel,
+) -> Result<Prepared> {
+    let speeds: Vec<f64> = observations
+        .cuts
+        .iter()
+        .map(|c| c.speed_rpm)
+        .chain(observations.poles.iter().map(|p| p.speed_rpm))
+        .collect();
+    if speeds.is_empty() {
+        return Err(GapError::Observations(
+            "no cuts and no poles: a diagnosis needs test cuts or identified poles \
+             (signals alone are not used; identify their poles first)"
+                .into(),
+        ));
+    }
+    let reference = Nominal::new(model, &[None], &speeds)?.reference_hz;
+    let data = Dataset::new(model, observations, noise, reference)?;
+    let nominal = Nominal::new(model, &data.immersions, &speeds)?;
+    Ok(Prepared { nominal, data })
+}
+
+/// The result of a diagnosis.
+#[derive(Debug, Clone, Serialize)]
+pub struct Diagnosis {
+    /// The class that explains the gap, or `unexplained`.
+    pub verdict: Verdict,
+    /// The best class: the most probable one, or `parameter_error` when no effect beats it by
+    /// the required Bayes factor (the verdict unless the predictive check failed).
+    pub best_class: EffectClass,
+    /// Every tried class with its evidence, probability and parameters.
+    pub classes: Vec<ClassReport>,
+    /// The posterior predictive check of the best class.
+    pub predictive_check: PredictiveCheck,
+    /// Where the gap between the nominal model and the data lies.
+    pub regions: Vec<Region>,
+    /// Held-out metrics before and after adding the best class (None when validation is off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shrink: Option<Shrink>,
+    /// How the shrinkage was measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation: Option<ValidationReport>,
+    /// Per-observation residuals against the nominal and the diagnosed model.
+    pub residuals: ResidualPair,
+    /// Why classes were left out, and what in the observations was not used.
+    pub notes: Vec<String>,
+    #[serde(skip)]
+    pub(crate) nominal: Machine,
+    #[serde(skip)]
+    pub(crate) diagnosed: Machine,
+}
+
+/// Residuals against the nominal model and against the diagnosed one (the best class at its
+/// highest-posterior sample).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ResidualPair {
+    /// Against the nominal model.
+    pub nominal: Residuals,
+    /// Against the diagnosed model.
+    pub diagnosed: Residuals,
+}
+
+/// One speed of a lobe diagram of the nominal and the diagnosed model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LobeComparison {
+    /// Spindle speed.
+    pub speed_rpm: f64,
+    /// Nominal limiting depth (mm; infinite where no lobe).
+    pub nominal_mm: f64,
+    /// Diagnosed limiting depth (mm), at the end of the campaign for drift.
+    pub diagnosed_mm: f64,
+}
+
+impl Diagnosis {
+    /// Limiting depths of the nominal and the diagnosed model at `speeds_rpm` (zero-order,
+    /// the model's own radial immersion).
+    pub fn lobes(&self, speeds_rpm: &[f64]) -> Vec<LobeComparison> {
+        let requests: Vec<(f64, usize)> = speeds_rpm.iter().map(|&s| (s, 0)).collect();
+        let nominal = self.nominal.boundary(&requests);
+        let diagnosed = self.diagnosed.boundary(&requests);
+        let end = self.diagnosed.drift_factor(1.0);
+        speeds_rpm
+            .iter()
+            .zip(nominal.iter().zip(&diagnosed))
+            .map(|(&speed_rpm, (n, d))| LobeComparison {
+                speed_rpm,
+                nominal_mm: n.depth_m * 1e3,
+                diagnosed_mm: d.scaled_depth(end).depth_m * 1e3,
+            })
+            .collect()
+    }
+}
+
+/// Diagnose the gap between `model` and `observations`.
+pub fn diagnose(
+    model: &ModalModel,
+    observations: &Observations,
+    options: &DiagnoseOptions,
+    observer: &dyn DiagnosisObserver,
+) -> Result<Diagnosis> {
+    let options = options.validated()?;
+    let Prepared { nominal, data } = prepare(model, observations, &options.noise)?;
+    let mut notes = Vec::new();
+    if !observations.signals.is_empty() {
+        notes.push(format!(
+            "{} signal records not used: identify their poles (`chatter oma`) and list them \
+             under `poles`",
+            observations.signals.len()
+        ));
+    }
+    let mut fitted = Vec::new();
+    for &class in &options.classes {
+        if let Some(why) = unavailable(class, &nominal, &data) {
+            notes.push(why);
+            continue;
+        }
+        let f = fit(
+            class,
+            &nominal,
+            &data,
+            &options,
+            options.samples,
+            class_seed(options.seed, class, 0),
+        )?;
+        observer.class_done(class, f.run.log_evidence);
+        fitted.push(f);
+    }
+    let evidences: Vec<f64> = fitted.iter().map(|f| f.run.log_evidence).collect();
+    let probabilities = class_probabilities(&evidences);
+    let most_probable = (0..fitted.len())
+        .max_by(|&a, &b| evidences[a].total_cmp(&evidences[b]))
+        .ok_or_else(|| GapError::Observations("no model class could be tried".into()))?;
+    // an effect is named only when it beats plain recalibration decisively
+    let recalibration = fitted
+        .iter()
+        .position(|f| f.model.class == EffectClass::ParameterError);
+    let best = match recalibration {
+        Some(r) if evidences[most_probable] - evidences[r] < options.min_log_bayes_factor => r,
+        _ => most_probable,
+    };
+    let predictions = posterior_predictions(&fitted[best], &data);
+    let check = predictive_check(
+        &predictions,
+        &data,
+        &options.noise,
+        options.check_level,
+        options.seed,
+    );
+    let best_class = fitted[best].model.class;
+    let verdict = if check.passed {
+        Verdict::Class(best_class)
+    } else {
+        Verdict::Unexplained
+    };
+    let classes = fitted
+        .iter()
+        .zip(&probabilities)
+        .map(|(f, &probability)| ClassReport {
+            name: f.model.class,
+            log_evidence: f.run.log_evidence,
+            probability,
+            data_fit: f.run.data_fit(),
+            information_gain: f.run.information_gain(),
+            parameters: summaries(f),
+        })
+        .collect();
+    let diagnosed = fitted[best]
+        .mode_machine()
+        .unwrap_or_else(|| nominal.machine.clone());
+    let nominal_prediction = predict(&nominal.machine, &data);
+    let residual_pair = ResidualPair {
+        nominal: residuals(&nominal_prediction, &data, &options.noise),
+        diagnosed: residuals(&predict(&diagnosed, &data), &data, &options.noise),
+    };
+    let context = RegionContext {
+        min_limit_mm: nominal_prediction
+            .cut_limit_m
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+            * 1e3,
+        cut_diameter_m: nominal.machine.diameter_m,
+        cut_chatter_hz: nominal_prediction.cut_chatter_hz.clone(),
+    };
+    let regions = regions(&residual_pair.nominal, &context);
+    let (shrink, validation) = match shrink(best_class, &nominal, &data, &options, observer)? {
+        Some((s, v)) => (Some(s), Some(v)),
+        None => (None, None),
+    };
+    Ok(Diagnosis {
+        verdict,
+        best_class,
+        classes,
+        predictive_check: check,
+        regions,
+        shrink,
+        validation,
+        residuals: residual_pair,
+        notes,
+        nominal: nominal.machine.clone(),
+        diagnosed,
+    })
+}
+
+/// Posterior mean and standard deviation of every physical parameter of a fitted class.
+fn summaries(f: &Fitted) -> BTreeMap<String, ParameterSummary> {
+    let rows: Vec<Vec<(&'static str, f64)>> = f
+        .run
+        .samples
+        .samples()
+        .iter()
+        .map(|t| f.model.physical(t))
+        .collect();
+    let mut out = BTreeMap::new();
+    let Some(first) = rows.first() else {
+        return out;
+    };
+    let n = rows.len() as f64;
+    for (k, (name, _)) in first.iter().enumerate() {
+        let mean = rows.iter().map(|r| r[k].1).sum::<f64>() / n;
+        let var = rows.iter().map(|r| (r[k].1 - mean).powi(2)).sum::<f64>() / n;
+        out.insert(
+            (*name).to_string(),
+            ParameterSummary {
+                mean,
+                sd: var.sqrt(),
+            },
+        );
+    }
+    out
+}
