@@ -14,8 +14,10 @@ pub trait Prior: Sync {
     fn sample(&self, rng: &mut dyn rand::RngCore) -> Vec<f64>;
 }
 
-/// A one-dimensional prior.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A one-dimensional prior. Its serde form is tagged by `kind`, e.g.
+/// `{"kind": "truncated_normal", "mean": 0, "sd": 0.03, "low": -0.03, "high": 0.03}`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Marginal {
     /// Uniform on [low, high].
     Uniform {

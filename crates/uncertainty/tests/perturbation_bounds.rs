@@ -10,6 +10,25 @@ use nalgebra::DMatrix;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
+/// The mode-2 parameters of seed 000 Section 6.2.
+fn mode2_parameters() -> Vec<Parameter> {
+    ["theta_omega_2", "theta_zeta_2", "theta_phi_2"]
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect()
+}
+
+/// The posterior covariance of seed 000, Eq. 34.
+fn eq34() -> DMatrix<f64> {
+    DMatrix::from_row_slice(
+        3,
+        3,
+        &[
+            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
+        ],
+    )
+}
+
 /// With a small covariance (a tenth of the seed-000 posterior, Eq. 34) the Eq. 17-18 mean and
 /// standard deviation of mu match 2000 Monte Carlo samples: mean within 1e-3 absolute, standard
 /// deviation within 15 % (Monte Carlo error of an sd with 2000 samples is ~1.6 %; the rest is the
@@ -17,17 +36,7 @@ use rand_distr::{Distribution, StandardNormal};
 #[test]
 fn moments_match_monte_carlo_and_widen() {
     let model = examples::ahmadi_2022_turning();
-    let params: Vec<Parameter> = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"]
-        .iter()
-        .map(|s| s.parse().unwrap())
-        .collect();
-    let eq34 = DMatrix::from_row_slice(
-        3,
-        3,
-        &[
-            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
-        ],
-    );
+    let (params, eq34) = (mode2_parameters(), eq34());
     let sigma = &eq34 * 0.1;
     let method = Discretization::full().with_steps(60);
     let (rpm, mm) = (7150.0, 2.0);
@@ -64,17 +73,7 @@ fn moments_match_monte_carlo_and_widen() {
 #[test]
 fn eq34_stable_cuts_lie_below_the_lower_bound() {
     let model = examples::ahmadi_2022_turning();
-    let params: Vec<Parameter> = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"]
-        .iter()
-        .map(|s| s.parse().unwrap())
-        .collect();
-    let eq34 = DMatrix::from_row_slice(
-        3,
-        3,
-        &[
-            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
-        ],
-    );
+    let (params, eq34) = (mode2_parameters(), eq34());
     let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549]).unwrap();
     // Table 2 stable cuts (rpm, mm).
     let stable = [
@@ -86,8 +85,8 @@ fn eq34_stable_cuts_lie_below_the_lower_bound() {
     ];
     for m in [&model, &updated] {
         for &(rpm, mm) in &stable {
-            let s = eigenvalue_sensitivity(Discretization::full(), m, &params, rpm, mm * 1e-3)
-                .unwrap();
+            let s =
+                eigenvalue_sensitivity(Discretization::full(), m, &params, rpm, mm * 1e-3).unwrap();
             let sens = EigenSensitivity {
                 mu: s.mu,
                 gradient: s.gradient,

@@ -17,6 +17,9 @@ pub enum UpdatingError {
     /// The model could not be built or perturbed.
     #[error(transparent)]
     Dynamics(#[from] chatter_dynamics::DynamicsError),
+    /// A sampler failed.
+    #[error(transparent)]
+    Bayes(#[from] chatter_bayes::BayesError),
     /// A stability computation failed.
     #[error(transparent)]
     Stability(#[from] chatter_stability::StabilityError),

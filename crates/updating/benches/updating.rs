@@ -1,0 +1,81 @@
+//! Sampler benches on the seeds' cases: 5000 iTMCMC samples of the 000 turning case (one model
+//! class, the exact characteristic-equation likelihood; target < 5 s on 2 cores) and TMCMC on the
+//! 002 milling case with the exact monodromy likelihood (fewer samples; the time scales linearly).
+
+use chatter_dynamics::examples;
+use chatter_stability::monodromy::Discretization;
+use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
+use chatter_updating::milling::MillingPoleLikelihood;
+use chatter_updating::parameters::{Parameterization, parse_model_parameters};
+use chatter_updating::turning::{ResidualForm, TurningPoleLikelihood, expand_repetitions};
+use chatter_updating::update::{UpdateJob, UpdateSettings};
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn model_parameters(job: &UpdateJob) -> String {
+    let n = job.parameter_names().len() - 1;
+    job.parameter_names()[..n].join(",")
+}
+
+fn ahmadi_2022(c: &mut Criterion) {
+    let model = examples::ahmadi_2022_turning();
+    let obs = examples::ahmadi_2022_turning_observations();
+    let job =
+        UpdateJob::new(&model, &obs, &UpdateSettings::default()).unwrap_or_else(|e| panic!("{e}"));
+    let p = Parameterization::new(
+        model,
+        parse_model_parameters(&model_parameters(&job)).unwrap_or_default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let like = TurningPoleLikelihood::new(
+        p,
+        expand_repetitions(&obs.poles),
+        1.0,
+        ResidualForm::PoleError,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let options = SamplerOptions {
+        sampler: Sampler::Itmcmc,
+        samples: 5000,
+        seed: 1,
+    };
+    let mut group = c.benchmark_group("ahmadi2022");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    group.bench_function("itmcmc_5000_samples_one_class", |b| {
+        b.iter(|| black_box(sample_posterior(job.prior(), &like, &options, &Silent)))
+    });
+    group.finish();
+}
+
+fn ebrahimi_2025(c: &mut Criterion) {
+    let model = examples::ebrahimi_2025_milling();
+    let obs = examples::ebrahimi_2025_milling_observations();
+    let job =
+        UpdateJob::new(&model, &obs, &UpdateSettings::default()).unwrap_or_else(|e| panic!("{e}"));
+    let p = Parameterization::new(
+        model,
+        parse_model_parameters(&model_parameters(&job)).unwrap_or_default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let like = MillingPoleLikelihood::new(p, &obs.poles, 0.01, Discretization::full())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let options = SamplerOptions {
+        sampler: Sampler::Tmcmc,
+        samples: 500,
+        seed: 1,
+    };
+    let mut group = c.benchmark_group("ebrahimi2025");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(60));
+    group.bench_function("tmcmc_500_samples_one_class_exact_monodromy", |b| {
+        b.iter(|| black_box(sample_posterior(job.prior(), &like, &options, &Silent)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, ahmadi_2022, ebrahimi_2025);
+criterion_main!(benches);

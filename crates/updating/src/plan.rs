@@ -1,0 +1,264 @@
+//! The next test cut (what `chatter plan` runs): sampled boundaries from the priors, updated with
+//! the cuts made so far, then value of information (003) or risk-based selection at maximum
+//! material removal rate (004), with the papers' stopping rules.
+
+use crate::boundary::BoundaryOptions;
+use crate::cuts::CutKernel;
+use crate::defaults::{default_parameters, parameter_prior};
+use crate::ensemble::{
+    BoundaryEnsemble, EnsembleObserver, TestPlan, material_removal_rate_cm3_per_min,
+};
+use crate::error::{Result, UpdatingError};
+use crate::parameters::{ModelParameter, Parameterization};
+use crate::update::PriorOverrides;
+use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_dynamics::{ModalModel, Observations};
+
+/// How the next test is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strategy {
+    /// Largest expected percent reduction of a parameter's standard deviation (003).
+    ValueOfInformation,
+    /// Largest material removal rate on the P_s = P_test contour (004).
+    MaterialRemovalRate,
+}
+
+/// Stop value of information below this expected reduction (percent).
+pub const VOI_STOP_PERCENT: f64 = 2.0;
+/// Stop risk-based testing when the next MRR improves the best stable one by less than this.
+pub const MRR_STOP_IMPROVEMENT: f64 = 0.10;
+
+/// Settings of a plan; `None` takes the defaults.
+#[derive(Debug, Clone)]
+pub struct PlanSettings {
+    /// Strategy.
+    pub strategy: Strategy,
+    /// P_test of the risk-based strategy (004 uses 0.5).
+    pub p_test: f64,
+    /// Parameters (default: kt, kn and C when the model has process damping).
+    pub parameters: Option<Vec<ModelParameter>>,
+    /// Priors by name.
+    pub priors: PriorOverrides,
+    /// The parameter whose uncertainty the value of information reduces (default C when
+    /// sampled, else the first parameter).
+    pub target: Option<ModelParameter>,
+    /// Number of sampled boundaries.
+    pub paths: usize,
+    /// Candidate speeds (default: the observed cut speeds +- 25 %, 41 speeds).
+    pub speeds_rpm: Option<Vec<f64>>,
+    /// Candidate depths in m (default: 60 depths up to twice the deepest cut).
+    pub depths_m: Option<Vec<f64>>,
+    /// Feed per tooth (m) for the material removal rate.
+    pub feed_per_tooth_m: f64,
+    /// Seed of the prior samples.
+    pub seed: u64,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        Self {
+            strategy: Strategy::MaterialRemovalRate,
+            p_test: 0.5,
+            parameters: None,
+            priors: PriorOverrides::new(),
+            target: None,
+            paths: 300,
+            speeds_rpm: None,
+            depths_m: None,
+            feed_per_tooth_m: 0.1e-3,
+            seed: 0,
+        }
+    }
+}
+
+/// The proposed cut and whether the stopping rule says testing is done.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PlanOutcome {
+    /// The next cut (None when no candidate qualifies).
+    pub next_cut: Option<TestPlan>,
+    /// The stopping rule fired (the gain of the next cut is small).
+    pub stop: bool,
+    /// Cuts used to update the samples.
+    pub cuts_used: usize,
+    /// Sampled parameter names.
+    pub parameter_names: Vec<String>,
+    /// Posterior mean after the cuts (003 Eq. 5).
+    pub posterior_mean: Vec<f64>,
+    /// Posterior standard deviation (003 Eq. 6).
+    pub posterior_sd: Vec<f64>,
+    /// Best material removal rate among the stable cuts (cm^3/min), where computable.
+    pub best_stable_mrr_cm3_per_min: Option<f64>,
+    /// Kish effective number of samples after the updates.
+    pub effective_samples: f64,
+}
+
+fn grid_default(observations: &Observations) -> Result<(Vec<f64>, Vec<f64>)> {
+    let cuts = &observations.cuts;
+    if cuts.is_empty() {
+        return Err(UpdatingError::InvalidInput {
+            field: "speeds",
+            message: "no cuts to centre the candidate grid on; give the speeds and depths".into(),
+        });
+    }
+    let lo = cuts
+        .iter()
+        .map(|c| c.speed_rpm)
+        .fold(f64::INFINITY, f64::min)
+        * 0.75;
+    let hi = cuts.iter().map(|c| c.speed_rpm).fold(0.0, f64::max) * 1.25;
+    let speeds = (0..41).map(|i| lo + (hi - lo) * i as f64 / 40.0).collect();
+    let deepest = cuts.iter().map(|c| c.depth_mm).fold(0.0, f64::max) * 1e-3;
+    let depths = (1..=60).map(|i| 2.0 * deepest * i as f64 / 60.0).collect();
+    Ok((speeds, depths))
+}
+
+/// Propose the next cut from the model, the cuts made so far and the settings.
+pub fn plan_next_cut(
+    model: &ModalModel,
+    observations: &Observations,
+    settings: &PlanSettings,
+    observer: &dyn EnsembleObserver,
+) -> Result<PlanOutcome> {
+    if !(settings.feed_per_tooth_m.is_finite() && settings.feed_per_tooth_m > 0.0) {
+        return Err(UpdatingError::InvalidInput {
+            field: "feed_per_tooth",
+            message: format!("{}; expected > 0", settings.feed_per_tooth_m),
+        });
+    }
+    let parameters = match &settings.parameters {
+        Some(p) => p.clone(),
+        None => default_parameters(model, &[])?,
+    };
+    let p = Parameterization::new(model.clone(), parameters)?;
+    let names = p.names();
+    let mut marginals: Vec<Marginal> = p
+        .parameters()
+        .iter()
+        .map(|q| parameter_prior(*q, model))
+        .collect();
+    for (name, spec) in &settings.priors {
+        let k =
+            names
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| UpdatingError::InvalidInput {
+                    field: "priors",
+                    message: format!("`{name}` is not a sampled parameter ({})", names.join(", ")),
+                })?;
+        marginals[k] = *spec;
+    }
+    let prior = IndependentPrior::new(marginals)?;
+    let (speeds, depths) = match (&settings.speeds_rpm, &settings.depths_m) {
+        (Some(s), Some(d)) => (s.clone(), d.clone()),
+        (s, d) => {
+            let (ds, dd) = grid_default(observations)?;
+            (s.clone().unwrap_or(ds), d.clone().unwrap_or(dd))
+        }
+    };
+    let max_depth = depths.iter().copied().fold(0.0, f64::max);
+    let options = BoundaryOptions {
+        max_depth_m: (2.0 * max_depth).max(1e-3),
+        ..Default::default()
+    };
+    let kernel = match settings.strategy {
+        Strategy::ValueOfInformation => CutKernel::karandikar(),
+        Strategy::MaterialRemovalRate => CutKernel::schmitz(),
+    };
+    let mut ensemble = BoundaryEnsemble::from_prior(
+        p.clone(),
+        &prior,
+        settings.paths,
+        &speeds,
+        options,
+        settings.seed,
+        observer,
+    )?;
+    for cut in &observations.cuts {
+        ensemble.update(cut, &kernel)?;
+    }
+    let moments = (0..p.dimension())
+        .map(|k| ensemble.moments(k))
+        .collect::<Result<Vec<_>>>()?;
+    let best_stable = observations
+        .cuts
+        .iter()
+        .filter(|c| c.stable)
+        .filter_map(|c| {
+            material_removal_rate_cm3_per_min(
+                model,
+                c.speed_rpm,
+                c.depth_mm * 1e-3,
+                settings.feed_per_tooth_m,
+            )
+        })
+        .reduce(f64::max);
+    let (next_cut, stop) = match settings.strategy {
+        Strategy::ValueOfInformation => {
+            let target = settings
+                .target
+                .or_else(|| {
+                    p.index_of(ModelParameter::ProcessDampingNPerM)
+                        .map(|_| ModelParameter::ProcessDampingNPerM)
+                })
+                .unwrap_or(p.parameters()[0]);
+            let index = p
+                .index_of(target)
+                .ok_or_else(|| UpdatingError::InvalidInput {
+                    field: "target",
+                    message: format!("`{target}` is not a sampled parameter"),
+                })?;
+            let plan = ensemble.value_of_information(&depths, index, &kernel)?;
+            let stop =
+                plan.is_none_or(|t| t.expected_reduction_percent.unwrap_or(0.0) < VOI_STOP_PERCENT);
+            (plan, stop)
+        }
+        Strategy::MaterialRemovalRate => {
+            let plan =
+                ensemble.risk_based_test(&depths, settings.p_test, settings.feed_per_tooth_m)?;
+            let stop = match (plan.and_then(|t| t.mrr_cm3_per_min), best_stable) {
+                (Some(next), Some(best)) => next < (1.0 + MRR_STOP_IMPROVEMENT) * best,
+                (None, _) => plan.is_none(),
+                (Some(_), None) => false,
+            };
+            (plan, stop)
+        }
+    };
+    Ok(PlanOutcome {
+        next_cut,
+        stop,
+        cuts_used: observations.cuts.len(),
+        parameter_names: names,
+        posterior_mean: moments.iter().map(|m| m.0).collect(),
+        posterior_sd: moments.iter().map(|m| m.1).collect(),
+        best_stable_mrr_cm3_per_min: best_stable,
+        effective_samples: ensemble.effective_sample_size(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ensemble::Silent;
+    use chatter_dynamics::examples;
+
+    #[test]
+    fn both_strategies_propose_a_cut_on_the_grid() {
+        let model = examples::ebrahimi_2025_milling();
+        let obs = examples::ebrahimi_2025_milling_observations();
+        for strategy in [Strategy::ValueOfInformation, Strategy::MaterialRemovalRate] {
+            let settings = PlanSettings {
+                strategy,
+                paths: 60,
+                ..Default::default()
+            };
+            let out = plan_next_cut(&model, &obs, &settings, &Silent).unwrap();
+            let cut = out.next_cut.unwrap();
+            assert!(cut.speed_rpm >= 2100.0 * 0.75 - 1e-9 && cut.speed_rpm <= 2400.0 * 1.25 + 1e-9);
+            assert_eq!(out.parameter_names, ["kt_n_per_mm2", "kn_n_per_mm2"]);
+            assert_eq!(out.cuts_used, 7);
+            assert!(out.best_stable_mrr_cm3_per_min.is_some());
+        }
+        let empty = Observations::default();
+        assert!(plan_next_cut(&model, &empty, &PlanSettings::default(), &Silent).is_err());
+    }
+}

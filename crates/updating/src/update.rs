@@ -1,0 +1,369 @@
+//! The updating job: from a model and observations to the posterior, the selected model class and
+//! the updated model (what `chatter update` runs).
+//!
+//! The data decide the likelihood: identified poles of a turning model use the
+//! characteristic-equation likelihood ([`crate::turning`], 000), identified poles of a milling
+//! model the Floquet-multiplier likelihood ([`crate::milling`], 002), both over model classes
+//! alpha; cut results alone use the cut likelihood ([`crate::cuts`], 004 Eq. 5 with its
+//! s_S = 0.125 mm and s_fc = 50 Hz) as a single class.
+//! Parameters, priors and classes default to the papers' ([`crate::defaults`]).
+
+use crate::boundary::BoundaryOptions;
+use crate::classes::{ClassObserver, SamplerOptions, sample_posterior, select_model_class};
+use crate::cuts::{CutKernel, CutsLikelihood};
+use crate::defaults::{
+    MILLING_ERROR_VARIANCE, TURNING_ERROR_VARIANCE, default_parameters, error_variance_prior,
+    milling_alphas, parameter_prior, turning_alphas,
+};
+use crate::error::{Result, UpdatingError};
+use crate::milling::MillingPoleLikelihood;
+use crate::parameters::{ModelParameter, Parameterization};
+use crate::turning::{ResidualForm, TurningPoleLikelihood, expand_repetitions};
+use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_bayes::samples::SampleSet;
+use chatter_dynamics::{Cut, ModalModel, Observations, Operation, PoleObservation};
+use chatter_stability::monodromy::Discretization;
+use nalgebra::DMatrix;
+use std::collections::BTreeMap;
+
+/// Priors by parameter name (a priors file); parameters not named keep their defaults.
+/// Each entry is a [`Marginal`] in its serde form, e.g.
+/// `{"kind": "truncated_normal", "mean": 0, "sd": 0.03, "low": -0.03, "high": 0.03}`.
+pub type PriorOverrides = BTreeMap<String, Marginal>;
+
+/// Which data the job updates on.
+#[derive(Debug, Clone)]
+enum Data {
+    TurningPoles(Vec<crate::turning::ObservedPole>),
+    MillingPoles(Vec<PoleObservation>),
+    Cuts(Vec<Cut>),
+}
+
+/// What the user may set; `None` takes the papers' defaults.
+#[derive(Debug, Clone, Default)]
+pub struct UpdateSettings {
+    /// Parameters to update.
+    pub parameters: Option<Vec<ModelParameter>>,
+    /// Priors by name.
+    pub priors: PriorOverrides,
+    /// Model classes alpha.
+    pub classes: Option<Vec<f64>>,
+}
+
+/// A validated updating job.
+#[derive(Debug, Clone)]
+pub struct UpdateJob {
+    parameterization: Parameterization,
+    prior: IndependentPrior,
+    names: Vec<String>,
+    alphas: Vec<f64>,
+    data: Data,
+}
+
+/// One model class in the result.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ClassSummary {
+    /// alpha (None for the cut likelihood, which has no classes).
+    pub alpha: Option<f64>,
+    /// ln p(D | M).
+    pub log_evidence: f64,
+    /// p(M | D).
+    pub probability: f64,
+}
+
+/// The result of a job.
+#[derive(Debug, Clone)]
+pub struct UpdateResult {
+    /// Sampled parameter names (model parameters, then the error variance where there is one).
+    pub parameter_names: Vec<String>,
+    /// Posterior samples of the selected class.
+    pub samples: SampleSet,
+    /// Posterior mean, same order as the names.
+    pub posterior_mean: Vec<f64>,
+    /// Posterior covariance.
+    pub posterior_covariance: DMatrix<f64>,
+    /// Every class.
+    pub classes: Vec<ClassSummary>,
+    /// The selected alpha.
+    pub selected_alpha: Option<f64>,
+    /// The model at the posterior mean of the model parameters.
+    pub updated_model: ModalModel,
+}
+
+impl UpdateJob {
+    /// Validate model, observations and settings into a job.
+    pub fn new(
+        model: &ModalModel,
+        observations: &Observations,
+        settings: &UpdateSettings,
+    ) -> Result<Self> {
+        let poles = &observations.poles;
+        if poles.is_empty() && observations.cuts.is_empty() {
+            return Err(UpdatingError::Observations(
+                "no identified poles and no cuts to update on".into(),
+            ));
+        }
+        let parameters = match &settings.parameters {
+            Some(p) if !p.is_empty() => p.clone(),
+            Some(_) => {
+                return Err(UpdatingError::InvalidInput {
+                    field: "parameters",
+                    message: "empty list".into(),
+                });
+            }
+            None => default_parameters(model, poles)?,
+        };
+        let parameterization = Parameterization::new(model.clone(), parameters)?;
+        let mut names = parameterization.names();
+        let mut marginals: Vec<Marginal> = parameterization
+            .parameters()
+            .iter()
+            .map(|p| parameter_prior(*p, model))
+            .collect();
+        let turning = matches!(model.operation(), Operation::Turning(_));
+        let (data, alphas) = if poles.is_empty() {
+            (Data::Cuts(observations.cuts.clone()), Vec::new())
+        } else {
+            names.push(
+                if turning {
+                    TURNING_ERROR_VARIANCE
+                } else {
+                    MILLING_ERROR_VARIANCE
+                }
+                .to_string(),
+            );
+            marginals.push(error_variance_prior(model));
+            let alphas = settings.classes.clone().unwrap_or_else(|| {
+                if turning {
+                    turning_alphas()
+                } else {
+                    milling_alphas()
+                }
+            });
+            let data = if turning {
+                Data::TurningPoles(expand_repetitions(poles))
+            } else {
+                Data::MillingPoles(poles.clone())
+            };
+            (data, alphas)
+        };
+        if let Some(a) = alphas.iter().find(|a| !(a.is_finite() && **a > 0.0)) {
+            return Err(UpdatingError::InvalidInput {
+                field: "classes",
+                message: format!("alpha {a}; expected > 0"),
+            });
+        }
+        for (name, spec) in &settings.priors {
+            let k = names.iter().position(|n| n == name).ok_or_else(|| {
+                UpdatingError::InvalidInput {
+                    field: "priors",
+                    message: format!(
+                        "`{name}` is not an updated parameter (updating {})",
+                        names.join(", ")
+                    ),
+                }
+            })?;
+            marginals[k] = *spec;
+        }
+        Ok(Self {
+            parameterization,
+            prior: IndependentPrior::new(marginals)?,
+            names,
+            alphas,
+            data,
+        })
+    }
+
+    /// Sampled parameter names (model parameters, then the error variance).
+    pub fn parameter_names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The model classes (empty for cut results).
+    pub fn alphas(&self) -> &[f64] {
+        &self.alphas
+    }
+
+    /// The joint prior.
+    pub fn prior(&self) -> &IndependentPrior {
+        &self.prior
+    }
+
+    /// Sample every class and summarize the selected one.
+    pub fn run(
+        &self,
+        options: &SamplerOptions,
+        observer: &dyn ClassObserver,
+    ) -> Result<UpdateResult> {
+        let p = &self.parameterization;
+        let (samples, classes, selected_alpha) = match &self.data {
+            Data::Cuts(cuts) => {
+                observer.class_started(0, 1, f64::NAN);
+                let like = CutsLikelihood::new(
+                    p.clone(),
+                    cuts.clone(),
+                    CutKernel::schmitz(),
+                    BoundaryOptions::default(),
+                )?;
+                let post = sample_posterior(&self.prior, &like, options, observer)?;
+                let class = ClassSummary {
+                    alpha: None,
+                    log_evidence: post.log_evidence,
+                    probability: 1.0,
+                };
+                (post.samples, vec![class], None)
+            }
+            Data::TurningPoles(poles) => {
+                let make = |alpha| {
+                    TurningPoleLikelihood::new(
+                        p.clone(),
+                        poles.clone(),
+                        alpha,
+                        ResidualForm::PoleError,
+                    )
+                };
+                summarize(select_model_class(
+                    &self.prior,
+                    &self.alphas,
+                    make,
+                    options,
+                    observer,
+                )?)
+            }
+            Data::MillingPoles(poles) => {
+                let make = |alpha| {
+                    MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())
+                };
+                summarize(select_model_class(
+                    &self.prior,
+                    &self.alphas,
+                    make,
+                    options,
+                    observer,
+                )?)
+            }
+        };
+        let mean = samples.mean();
+        let updated_model = p.model(&mean[..p.dimension()])?;
+        Ok(UpdateResult {
+            parameter_names: self.names.clone(),
+            posterior_covariance: samples.covariance(),
+            posterior_mean: mean,
+            samples,
+            classes,
+            selected_alpha,
+            updated_model,
+        })
+    }
+}
+
+fn summarize(
+    selection: crate::classes::ClassSelection,
+) -> (SampleSet, Vec<ClassSummary>, Option<f64>) {
+    let classes = selection
+        .classes
+        .iter()
+        .zip(&selection.probabilities)
+        .map(|(c, &probability)| ClassSummary {
+            alpha: Some(c.alpha),
+            log_evidence: c.posterior.log_evidence,
+            probability,
+        })
+        .collect();
+    let selected = selection.selected_class();
+    (
+        selected.posterior.samples.clone(),
+        classes,
+        Some(selected.alpha),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::classes::{Sampler, Silent};
+    use chatter_dynamics::examples;
+
+    #[test]
+    fn priors_files_parse_strictly_and_name_checks_hold() {
+        let text = r#"{"theta_omega_2": {"kind": "truncated_normal", "mean": 0, "sd": 0.01,
+                       "low": -0.03, "high": 0.03},
+                       "sigma_r2": {"kind": "uniform", "low": 1e-10, "high": 1}}"#;
+        let priors: PriorOverrides = serde_json::from_str(text).unwrap();
+        let bad = r#"{"theta_omega_2": {"kind": "uniform", "low": 0, "high": 1, "x": 2}}"#;
+        assert!(serde_json::from_str::<PriorOverrides>(bad).is_err());
+        let model = examples::ahmadi_2022_turning();
+        let obs = examples::ahmadi_2022_turning_observations();
+        let job = UpdateJob::new(
+            &model,
+            &obs,
+            &UpdateSettings {
+                priors: priors.clone(),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(
+            job.parameter_names(),
+            ["theta_omega_2", "theta_zeta_2", "theta_phi_2", "sigma_r2"]
+        );
+        assert_eq!(job.alphas().len(), 16);
+        assert_eq!(
+            job.prior().marginals()[3],
+            Marginal::Uniform {
+                low: 1e-10,
+                high: 1.0
+            }
+        );
+        let mut unknown = priors;
+        unknown.insert("theta_k_1".into(), Marginal::Normal { mean: 0.0, sd: 1.0 });
+        let settings = UpdateSettings {
+            priors: unknown,
+            ..Default::default()
+        };
+        assert!(UpdateJob::new(&model, &obs, &settings).is_err());
+    }
+
+    #[test]
+    fn cut_results_update_the_cutting_coefficient() {
+        // stable at 0.3 mm, chatter at 0.9 mm (2100 rpm) on the 002 machine: kn moves to the
+        // values whose limit lies between
+        let model = examples::ebrahimi_2025_milling();
+        let mut obs = Observations::default();
+        for (depth_mm, stable) in [(0.3, true), (0.9, false)] {
+            obs.cuts.push(Cut {
+                speed_rpm: 2100.0,
+                depth_mm,
+                stable,
+                chatter_hz: None,
+                sequence: None,
+                radial_immersion: None,
+                note: None,
+            });
+        }
+        let settings = UpdateSettings {
+            parameters: Some(vec![ModelParameter::KnNPerMm2]),
+            ..Default::default()
+        };
+        let job = UpdateJob::new(&model, &obs, &settings).unwrap();
+        let options = SamplerOptions {
+            sampler: Sampler::Itmcmc,
+            samples: 200,
+            seed: 1,
+        };
+        let result = job.run(&options, &Silent).unwrap();
+        assert_eq!(result.classes.len(), 1);
+        assert!(result.selected_alpha.is_none());
+        let limit = |kn: f64| {
+            let m = Parameterization::new(model.clone(), vec![ModelParameter::KnNPerMm2])
+                .unwrap()
+                .model(&[kn])
+                .unwrap();
+            crate::boundary::limiting_depth(&m, 2100.0, &BoundaryOptions::default())
+                .unwrap()
+                .depth_m
+        };
+        let b = limit(result.posterior_mean[0]);
+        assert!(b > 0.3e-3 && b < 0.9e-3, "{b}");
+    }
+}
