@@ -3,13 +3,17 @@
 
 mod bands;
 mod commands;
+mod diagnose;
 mod inputs;
+mod oma;
 mod output;
+mod plan;
 mod plot;
 mod progress;
+mod update;
 
-use clap::{Parser, Subcommand};
 use bands::BandKind;
+use clap::{Parser, Subcommand};
 use commands::Method;
 use std::path::PathBuf;
 
@@ -187,6 +191,54 @@ enum Command {
         #[arg(long, default_value_t = 0.05)]
         feed_per_tooth_mm: f64,
     },
+    /// Sim-to-real gap diagnosis: where the model and the observations disagree, which
+    /// unmodelled effect explains it, how far the gap shrinks on held-out data. JSON to stdout.
+    Diagnose {
+        /// Nominal model file.
+        #[arg(long)]
+        model: PathBuf,
+        /// Observations file (JSON or cuts CSV).
+        #[arg(long)]
+        observations: PathBuf,
+        /// Seed of the samplers and the folds.
+        #[arg(long)]
+        seed: u64,
+        /// iTMCMC samples per model class.
+        #[arg(long, default_value_t = 250)]
+        samples: usize,
+        /// Held-out validation of the shrinkage.
+        #[arg(long, value_enum, default_value = "kfold")]
+        validation: diagnose::ValidationArg,
+        /// Folds (or speed bands) of the validation.
+        #[arg(long, default_value_t = 5)]
+        folds: usize,
+        /// Folder for diagnosis.json (with residuals), lobes.svg and residuals.svg.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Bayesian model updating: posterior.csv, summary.json, updated_model.json, evidence and
+    /// corner plots in --out.
+    Update(update::UpdateArgs),
+    /// The next test cut as JSON: value of information (003) or maximum MRR at a risk (004).
+    Plan(plan::PlanArgs),
+    /// Operational modal analysis of every signal of an observations file: prints observations
+    /// JSON whose `poles` hold the identified dominant poles (modified LSCE with the spindle
+    /// harmonics; lifting and polyreference for a milling model).
+    Oma {
+        /// Observations file listing the `signals` (CSV or WAV).
+        #[arg(long)]
+        observations: PathBuf,
+        /// Machine model; a milling model makes the identification lifted at the tooth period.
+        #[arg(long)]
+        model: Option<PathBuf>,
+        /// Write the JSON here instead of stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// SVG stabilization diagram over the first singular value of the PSD (with several
+        /// signals, one file per signal: NAME-1.svg, NAME-2.svg, ...).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
     /// Run the main job on the embedded examples and write the results to a folder.
     Demo {
         /// Output folder.
@@ -323,6 +375,37 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
             commands::simulate(&model, &s, &out, quiet)
         }
+        Command::Diagnose {
+            model,
+            observations,
+            seed,
+            samples,
+            validation,
+            folds,
+            out,
+        } => diagnose::run(&diagnose::DiagnoseRequest {
+            model: &model,
+            observations: &observations,
+            seed,
+            samples,
+            validation,
+            folds,
+            out: out.as_deref(),
+            quiet,
+        }),
+        Command::Update(args) => update::run(&args, quiet),
+        Command::Plan(args) => plan::run(&args, quiet),
+        Command::Oma {
+            observations,
+            model,
+            out,
+            plot,
+        } => oma::oma(
+            &observations,
+            model.as_deref(),
+            out.as_deref(),
+            plot.as_deref(),
+        ),
         Command::Demo { out } => commands::demo(&out, quiet),
     }
 }

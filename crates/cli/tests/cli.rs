@@ -138,6 +138,9 @@ fn demo_writes_its_folder() {
         "eq34_covariance.json",
         "turning_credibility.csv",
         "turning_credibility.svg",
+        "shopfloor_observations.json",
+        "diagnosis/lobes.svg",
+        "diagnosis/residuals.svg",
         "summary.json",
     ] {
         assert!(dir.path().join(f).exists(), "{f} missing");
@@ -146,6 +149,7 @@ fn demo_writes_its_folder() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
             .unwrap();
     assert_eq!(summary["turning_limits"].as_array().unwrap().len(), 4);
+    assert_eq!(summary["diagnosis"]["verdict"], "process_damping");
 }
 
 #[test]
@@ -228,9 +232,16 @@ fn perturbation_bands_bracket_the_mean() {
         .arg(&plot)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm\n"), "{text}");
+    assert!(
+        text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm\n"),
+        "{text}"
+    );
     let rows = csv_rows(&text);
     assert_eq!(rows.len(), 3);
     for r in &rows {
@@ -272,7 +283,11 @@ fn montecarlo_bands_and_map() {
         .arg(&map)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm,chatter_hz_q05"));
     for r in csv_rows(&text) {
@@ -291,5 +306,469 @@ fn montecarlo_bands_and_map() {
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8(out.stderr).unwrap();
-    assert!(err.contains("--posterior") && err.contains("--covariance"), "{err}");
+    assert!(
+        err.contains("--posterior") && err.contains("--covariance"),
+        "{err}"
+    );
+}
+
+/// Synthetic shop-floor data with hidden process damping: `chatter diagnose` names it, reports
+/// every class, the regions and the held-out shrinkage, and writes the plots.
+#[test]
+fn diagnose_names_the_hidden_effect_and_writes_plots() {
+    use chatter_gap::{HiddenEffect, Scenario, nominal_milling, synthesize};
+    let dir = tempfile::tempdir().unwrap();
+    let nominal = nominal_milling().unwrap();
+    let data = synthesize(
+        &nominal,
+        &Scenario::new(HiddenEffect::ProcessDamping { c_n_per_m: 6e4 }, 5),
+    )
+    .unwrap();
+    let model_path = dir.path().join("model.json");
+    let obs_path = dir.path().join("observations.json");
+    std::fs::write(&model_path, nominal.to_json_string()).unwrap();
+    std::fs::write(&obs_path, data.to_json_string()).unwrap();
+    let out_dir = dir.path().join("gap");
+    let out = chatter()
+        .args([
+            "diagnose", "--quiet", "--seed", "3", "--folds", "3", "--model",
+        ])
+        .arg(&model_path)
+        .arg("--observations")
+        .arg(&obs_path)
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["verdict"], "process_damping", "{report}");
+    let classes = report["classes"].as_array().unwrap();
+    assert_eq!(classes.len(), 5);
+    let total: f64 = classes
+        .iter()
+        .map(|c| c["probability"].as_f64().unwrap())
+        .sum();
+    assert!((total - 1.0).abs() < 1e-9);
+    assert!(classes.iter().all(|c| c["log_evidence"].is_number()
+        && c["parameters"]["frequency_factor"]["mean"].is_number()));
+    assert!(!report["regions"].as_array().unwrap().is_empty());
+    let lpd = &report["shrink"]["log_predictive_density_per_observation"];
+    assert!(lpd["after"].as_f64().unwrap() > lpd["before"].as_f64().unwrap());
+    assert!(report.get("residuals").is_none());
+    for file in ["diagnosis.json", "lobes.svg", "residuals.svg"] {
+        assert!(out_dir.join(file).exists(), "{file}");
+    }
+    let full: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("diagnosis.json")).unwrap())
+            .unwrap();
+    assert!(
+        full["residuals"]["nominal"]["cuts"]
+            .as_array()
+            .unwrap()
+            .len()
+            > 100
+    );
+}
+
+/// Clear errors: observations without cuts or poles, and invalid options.
+#[test]
+fn diagnose_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let obs = dir.path().join("signals_only.json");
+    std::fs::write(
+        &obs,
+        r#"{"signals": [{"file": "s.csv", "speed_rpm": 7000, "depth_mm": 1.0, "sample_rate_hz": 1000}]}"#,
+    )
+    .unwrap();
+    let out = chatter()
+        .args(["diagnose", "--quiet", "--seed", "1", "--model"])
+        .arg(example("schmitz2023_milling_model.json"))
+        .arg("--observations")
+        .arg(&obs)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("signals_only.json") && err.contains("no cuts and no poles"),
+        "{err}"
+    );
+    let out = chatter()
+        .args([
+            "diagnose",
+            "--quiet",
+            "--seed",
+            "1",
+            "--samples",
+            "10",
+            "--model",
+        ])
+        .arg(example("schmitz2023_milling_model.json"))
+        .arg("--observations")
+        .arg(example("ebrahimi2025_milling_observations.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("samples"), "{err}");
+}
+
+#[test]
+fn update_writes_posterior_summary_model_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("posterior");
+    let out = chatter()
+        .args([
+            "update",
+            "--quiet",
+            "--classes",
+            "0.5,1",
+            "--samples",
+            "200",
+            "--seed",
+            "3",
+            "--model",
+        ])
+        .arg(example("ahmadi2022_turning_model.json"))
+        .arg("--observations")
+        .arg(example("ahmadi2022_turning_observations.json"))
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let names: Vec<&str> = summary["parameter_names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        ["theta_omega_2", "theta_zeta_2", "theta_phi_2", "sigma_r2"]
+    );
+    assert_eq!(summary["posterior_mean"].as_array().unwrap().len(), 4);
+    assert_eq!(summary["posterior_covariance"].as_array().unwrap().len(), 4);
+    let classes = summary["classes"].as_array().unwrap();
+    assert_eq!(classes.len(), 2);
+    let total: f64 = classes
+        .iter()
+        .map(|c| c["probability"].as_f64().unwrap())
+        .sum();
+    assert!((total - 1.0).abs() < 1e-9);
+    let selected = summary["selected_alpha"].as_f64().unwrap();
+    assert!(selected == 0.5 || selected == 1.0);
+    let theta_omega = summary["posterior_mean"][0].as_f64().unwrap();
+    assert!(theta_omega > 0.002 && theta_omega < 0.01, "{theta_omega}");
+    let csv = std::fs::read_to_string(out_dir.join("posterior.csv")).unwrap();
+    assert!(csv.starts_with("theta_omega_2,theta_zeta_2,theta_phi_2,sigma_r2,weight\n"));
+    assert_eq!(csv.lines().count(), 201);
+    for plot in ["evidence.svg", "corner.svg"] {
+        let svg = std::fs::read_to_string(out_dir.join(plot)).unwrap();
+        assert!(svg.contains("<svg"), "{plot}");
+    }
+    // the updated model is a valid model file with the mode-2 frequency raised
+    let updated = out_dir.join("updated_model.json");
+    let check = chatter()
+        .args(["check", "--model"])
+        .arg(&updated)
+        .output()
+        .unwrap();
+    assert!(
+        check.status.success(),
+        "{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    let model: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&updated).unwrap()).unwrap();
+    let f2 = model["modes"][1]["frequency_hz"].as_f64().unwrap();
+    assert!((f2 - 2445.0 * (1.0 + theta_omega)).abs() < 1e-6);
+}
+
+#[test]
+fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    // identified milling poles with TMCMC (002)
+    let out_dir = dir.path().join("tmcmc");
+    let out = chatter()
+        .args([
+            "update",
+            "--quiet",
+            "--sampler",
+            "tmcmc",
+            "--classes",
+            "0.01",
+            "--samples",
+            "40",
+            "--seed",
+            "1",
+            "--parameters",
+            "theta_omega_1,theta_zeta_1",
+            "--model",
+        ])
+        .arg(example("ebrahimi2025_milling_model.json"))
+        .arg("--observations")
+        .arg(example("ebrahimi2025_milling_observations.json"))
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = std::fs::read_to_string(out_dir.join("summary.json")).unwrap();
+    assert!(summary.contains("sigma_w2_hz2"), "{summary}");
+    // cut results with rejection sampling + adaptive MCMC (004): one class, no alpha
+    let cuts = dir.path().join("cuts.csv");
+    std::fs::write(
+        &cuts,
+        "speed_rpm,depth_mm,stable,chatter_hz\n2100,0.3,true,\n2100,0.9,false,196\n",
+    )
+    .unwrap();
+    let out_dir = dir.path().join("amcmc");
+    let out = chatter()
+        .args([
+            "update",
+            "--quiet",
+            "--sampler",
+            "amcmc",
+            "--samples",
+            "60",
+            "--seed",
+            "1",
+            "--parameters",
+            "kn_n_per_mm2",
+            "--model",
+        ])
+        .arg(example("ebrahimi2025_milling_model.json"))
+        .arg("--observations")
+        .arg(&cuts)
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert!(summary["selected_alpha"].is_null());
+    assert_eq!(summary["parameter_names"][0], "kn_n_per_mm2");
+    let priors = dir.path().join("priors.json");
+    std::fs::write(
+        &priors,
+        r#"{"theta_k_7": {"kind": "uniform", "low": 0, "high": 1}}"#,
+    )
+    .unwrap();
+    for extra in [
+        vec!["--classes".to_string(), "abc".to_string()],
+        vec!["--priors".to_string(), priors.display().to_string()],
+        vec!["--parameters".to_string(), "theta_bogus_1".to_string()],
+    ] {
+        let out = chatter()
+            .args([
+                "update",
+                "--quiet",
+                "--samples",
+                "20",
+                "--seed",
+                "1",
+                "--model",
+            ])
+            .arg(example("ahmadi2022_turning_model.json"))
+            .arg("--observations")
+            .arg(example("ahmadi2022_turning_observations.json"))
+            .arg("--out")
+            .arg(dir.path().join("never"))
+            .args(&extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{extra:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(
+            err.contains("abc") || err.contains("theta_k_7") || err.contains("theta_bogus_1"),
+            "{err}"
+        );
+        assert!(!dir.path().join("never").exists());
+    }
+}
+
+#[test]
+fn plan_prints_the_next_cut() {
+    for strategy in ["voi", "mrr"] {
+        let out = chatter()
+            .args([
+                "plan",
+                "--quiet",
+                "--paths",
+                "40",
+                "--strategy",
+                strategy,
+                "--model",
+            ])
+            .arg(example("ebrahimi2025_milling_model.json"))
+            .arg("--observations")
+            .arg(example("ebrahimi2025_milling_observations.json"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(plan["strategy"], strategy);
+        let speed = plan["next_cut"]["speed_rpm"].as_f64().unwrap();
+        assert!((1575.0..=3000.0).contains(&speed), "{speed}");
+        assert!(plan["next_cut"]["depth_mm"].as_f64().unwrap() > 0.0);
+        assert!(plan["stop"].is_boolean());
+    }
+    let out = chatter()
+        .args([
+            "plan",
+            "--quiet",
+            "--strategy",
+            "mrr",
+            "--p-test",
+            "1.5",
+            "--model",
+        ])
+        .arg(example("ebrahimi2025_milling_model.json"))
+        .arg("--observations")
+        .arg(example("ebrahimi2025_milling_observations.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8(out.stderr).unwrap().contains("p_test"));
+}
+
+/// `chatter oma` on a small signal file: a seeded 800 Hz mode (zeta 2 %) on two channels plus a
+/// once-per-revolution tachometer at 7150 rpm, 4 s at 10 kHz. The pole comes back in the
+/// observations schema (frequency within 0.4 %, damping within 20 %, ten repetitions), the
+/// stabilization diagram is drawn, and bad entries name the file and the field.
+#[test]
+fn oma_identifies_the_signals_of_an_observations_file() {
+    use chatter_oma::synthetic::{SyntheticMode, SyntheticRecord};
+    let dir = tempfile::tempdir().unwrap();
+    let fs = 10_000.0;
+    let record = SyntheticRecord {
+        channels: vec!["a1".into(), "a2".into()],
+        modes: vec![SyntheticMode {
+            frequency_hz: 800.0,
+            damping_ratio: 0.02,
+            shape: vec![1.0, 0.5],
+        }],
+        harmonics: Vec::new(),
+        noise_fraction: 0.1,
+        sample_rate_hz: fs,
+        duration_s: 4.0,
+        seed: 3,
+    };
+    let signals = record.generate().unwrap();
+    let samples_per_rev = fs * 60.0 / 7150.0;
+    let mut csv = String::from("a1,a2,tach\n");
+    for k in 0..signals.data[0].len() {
+        let tach = if (k as f64 % samples_per_rev) < 3.0 {
+            1
+        } else {
+            0
+        };
+        csv.push_str(&format!(
+            "{:e},{:e},{tach}\n",
+            signals.data[0][k], signals.data[1][k]
+        ));
+    }
+    std::fs::write(dir.path().join("rec.csv"), csv).unwrap();
+    let write_obs = |entry: &str| {
+        let path = dir.path().join("obs.json");
+        std::fs::write(
+            &path,
+            format!(
+                r#"{{ "cuts": [{{ "speed_rpm": 7150, "depth_mm": 2.0, "stable": true }}],
+                     "signals": [{entry}] }}"#
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let obs = write_obs(
+        r#"{ "file": "rec.csv", "speed_rpm": 7150, "depth_mm": 2.0, "sample_rate_hz": 10000,
+             "once_per_rev_channel": "tach", "quantity": "acceleration" }"#,
+    );
+    let svg = dir.path().join("diagram.svg");
+    let out = chatter()
+        .args(["oma", "--observations"])
+        .arg(&obs)
+        .arg("--plot")
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(result["cuts"].as_array().unwrap().len(), 1);
+    let pole = &result["poles"][0];
+    assert_eq!(pole["speed_rpm"], 7150.0);
+    let f = pole["frequency_hz"].as_f64().unwrap();
+    let zeta = pole["damping_ratio"].as_f64().unwrap();
+    assert!((f - 800.0).abs() < 0.004 * 800.0, "{pole}");
+    assert!((zeta - 0.02).abs() < 0.2 * 0.02, "{pole}");
+    assert_eq!(pole["repetitions"], 10);
+    assert!(pole["frequency_std_hz"].as_f64().unwrap() > 0.0);
+    assert!(pole["note"].as_str().unwrap().contains("modified LSCE"));
+    // the output is itself a valid observations file
+    let reread = dir.path().join("poles.json");
+    std::fs::write(&reread, &out.stdout).unwrap();
+    chatter_dynamics::Observations::from_path(&reread).unwrap();
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+
+    for (entry, expected) in [
+        (
+            r#"{ "file": "rec.csv", "speed_rpm": 7150, "depth_mm": 2.0 }"#,
+            "sample_rate_hz",
+        ),
+        (
+            r#"{ "file": "rec.csv", "speed_rpm": 7150, "depth_mm": 2.0, "sample_rate_hz": 10000,
+                 "once_per_rev_channel": "tacho" }"#,
+            "once_per_rev_channel",
+        ),
+        (
+            r#"{ "file": "missing.csv", "speed_rpm": 7150, "depth_mm": 2.0,
+                 "sample_rate_hz": 10000 }"#,
+            "missing.csv",
+        ),
+    ] {
+        let obs = write_obs(entry);
+        let out = chatter()
+            .args(["oma", "--observations"])
+            .arg(&obs)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(
+            err.contains("obs.json") && err.contains("signals[0]") && err.contains(expected),
+            "{err}"
+        );
+    }
 }

@@ -230,6 +230,8 @@ pub fn simulate_with_observer(
     let cv = model.process_damping_per_width(settings.speed_rpm);
     // surface ring buffer: one value per edge per step over one delay
     let mut surface = vec![f64::NAN; steps_per_delay * edges];
+    // the slot's surfaces as they were one delay ago, read before any edge overwrites them
+    let mut previous_slot = vec![f64::NAN; edges];
 
     let mut rng = rand::rngs::StdRng::seed_from_u64(settings.seed);
     let n_out = (settings.duration_s * settings.sample_rate_hz).floor() as usize;
@@ -255,6 +257,7 @@ pub fn simulate_with_observer(
         // cutting forces from every edge
         let mut f = [0.0f64; 2];
         let slot = step % steps_per_delay;
+        previous_slot.copy_from_slice(&surface[slot * edges..(slot + 1) * edges]);
         for j in 0..edges {
             let (n_dir, u, in_cut) = match &milling {
                 None => ([1.0, 0.0], [kn, kt], true),
@@ -269,11 +272,11 @@ pub fn simulate_with_observer(
                 }
             };
             // edge position along n including the rigid feed motion
-            let e = n_dir[0] * (x[0] + feed_speed * t) + n_dir[1] * x[1];
+            let e = n_dir[0] * (feed_speed * t - x[0]) - n_dir[1] * x[1];
             // the surface at this angle was left one delay ago by the next edge (milling) or the
             // same edge (turning)
             let prev_edge = (j + 1) % edges;
-            let previous = surface[slot * edges + prev_edge];
+            let previous = previous_slot[prev_edge];
             let s_prev = if previous.is_nan() {
                 e - settings.feed_per_tooth_m * n_dir[0] // rigid first pass
             } else {

@@ -21,6 +21,9 @@ pub enum OmaError {
         /// What was expected.
         message: String,
     },
+    /// No pole satisfied the identification criteria.
+    #[error("no pole identified: {0}")]
+    NoPole(String),
     /// A least-squares or eigenvalue problem failed.
     #[error("{0}")]
     Numerical(String),

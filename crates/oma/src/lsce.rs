@@ -19,7 +19,7 @@ use num_complex::Complex64;
 use std::f64::consts::PI;
 
 /// An identified pole.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pole {
     /// Discrete-time pole mu.
     pub multiplier: Complex64,
@@ -46,6 +46,23 @@ impl Pole {
             harmonic,
         }
     }
+
+    /// Principal frequency arg(mu) / (2 pi T_s) = Im(lambda) / 2 pi (Hz), in [0, 1 / (2 T_s)]
+    /// for the upper half-plane representative: the frequency seen in data sampled at T_s (for
+    /// lifted data, the principal frequency of the Floquet multiplier, as in 002 Table 2).
+    pub fn principal_frequency_hz(&self) -> f64 {
+        self.lambda.im.abs() / (2.0 * PI)
+    }
+}
+
+/// The non-harmonic poles of the discrete roots `mu` in the closed upper half-plane (one of each
+/// conjugate pair; real roots included), leaving out the zero root, which has no continuous-time
+/// counterpart.
+pub(crate) fn upper_poles(mu: impl IntoIterator<Item = Complex64>, ts: f64) -> Vec<Pole> {
+    mu.into_iter()
+        .filter(|z| z.im >= 0.0 && z.norm() > 0.0)
+        .map(|z| Pole::from_multiplier(z, ts, false))
+        .collect()
 }
 
 /// Polynomial coefficients (ascending, monic) of prod_k (z^2 - 2 cos(w_k ts) z + 1).
@@ -135,11 +152,7 @@ pub fn lsce(
     let beta = svd
         .solve(&b, 1e-13 * svd.singular_values.max())
         .map_err(|e| OmaError::Numerical(format!("least squares failed: {e}")))?;
-    let mut poles: Vec<Pole> = roots(beta.as_slice())
-        .into_iter()
-        .filter(|z| z.im >= 0.0)
-        .map(|z| Pole::from_multiplier(z, ts, false))
-        .collect();
+    let mut poles = upper_poles(roots(beta.as_slice()), ts);
     poles.extend(harmonics_hz.iter().map(|&f| {
         let w = 2.0 * PI * f * ts;
         Pole::from_multiplier(Complex64::new(w.cos(), w.sin()), ts, true)

@@ -49,6 +49,58 @@ impl Signals {
         self.names.iter().position(|n| n == name)
     }
 
+    /// Mean interval (s) between the rising edges of the pulse train in `channel` (a
+    /// once-per-revolution tachometer): crossings of the level halfway between the channel's
+    /// minimum and maximum, located to a fraction of a sample by linear interpolation. Needs at
+    /// least two edges.
+    pub fn pulse_period_s(&self, channel: usize) -> Result<f64> {
+        let x = self
+            .data
+            .get(channel)
+            .ok_or_else(|| OmaError::InvalidInput {
+                field: "once_per_rev_channel",
+                message: format!("channel {channel} of {}", self.data.len()),
+            })?;
+        let (lo, hi) = x
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            });
+        let level = 0.5 * (lo + hi);
+        let edges: Vec<f64> = x
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[0] < level && w[1] >= level)
+            .map(|(k, w)| k as f64 + (level - w[0]) / (w[1] - w[0]))
+            .collect();
+        match (edges.first(), edges.last()) {
+            (Some(first), Some(last)) if edges.len() >= 2 => {
+                Ok((last - first) / (edges.len() - 1) as f64 / self.sample_rate_hz)
+            }
+            _ => Err(OmaError::InvalidInput {
+                field: "once_per_rev_channel",
+                message: format!(
+                    "channel `{}` has {} rising edges; need at least two pulses",
+                    self.names[channel],
+                    edges.len()
+                ),
+            }),
+        }
+    }
+
+    /// These signals without the channel `channel` (e.g. a tachometer before identification).
+    pub fn without_channel(&self, channel: usize) -> Result<Self> {
+        let (names, data) = self
+            .names
+            .iter()
+            .zip(&self.data)
+            .enumerate()
+            .filter(|(c, _)| *c != channel)
+            .map(|(_, (n, d))| (n.clone(), d.clone()))
+            .unzip();
+        Self::new(names, self.sample_rate_hz, data)
+    }
+
     /// Read a CSV record at `sample_rate_hz`.
     pub fn from_csv(path: &Path, sample_rate_hz: f64) -> Result<Self> {
         let err = |message: String| OmaError::File {
@@ -125,5 +177,70 @@ impl Signals {
         }
         let names = names.unwrap_or_else(|| (1..=nc).map(|i| format!("ch{i}")).collect());
         Self::new(names, spec.sample_rate as f64, data).map_err(|e| err(e.to_string()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_round_trip_and_errors_name_line_and_channel() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rec.csv");
+        std::fs::write(&path, "a, b,tach\n1.0,2,0\n-1e-3,4,1\n\n5,6,0\n").unwrap();
+        let s = Signals::from_csv(&path, 100.0).unwrap();
+        assert_eq!(s.names, vec!["a", "b", "tach"]);
+        assert_eq!(s.data[0], vec![1.0, -1e-3, 5.0]);
+        assert_eq!(s.channel("tach"), Some(2));
+        let without = s.without_channel(2).unwrap();
+        assert_eq!(without.names, vec!["a", "b"]);
+        std::fs::write(&path, "a,b\n1,2\n3,x\n").unwrap();
+        let e = Signals::from_csv(&path, 100.0).unwrap_err().to_string();
+        assert!(
+            e.contains("rec.csv") && e.contains("line 3") && e.contains("`b`"),
+            "{e}"
+        );
+        std::fs::write(&path, "a,b\n1,2\n3\n").unwrap();
+        let e = Signals::from_csv(&path, 100.0).unwrap_err().to_string();
+        assert!(e.contains("line 3: 1 values for 2 channels"), "{e}");
+    }
+
+    #[test]
+    fn wav_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rec.wav");
+        let spec = hound::WavSpec {
+            channels: 2,
+            sample_rate: 8000,
+            bits_per_sample: 32,
+            sample_format: hound::SampleFormat::Float,
+        };
+        let mut w = hound::WavWriter::create(&path, spec).unwrap();
+        for k in 0..10 {
+            w.write_sample(k as f32 * 0.1).unwrap();
+            w.write_sample(-(k as f32)).unwrap();
+        }
+        w.finalize().unwrap();
+        let s = Signals::from_wav(&path, None).unwrap();
+        assert_eq!(s.names, vec!["ch1", "ch2"]);
+        assert_eq!(s.sample_rate_hz, 8000.0);
+        assert_eq!(s.data[1][3], -3.0);
+        assert!((s.data[0][4] - 0.4).abs() < 1e-7);
+    }
+
+    #[test]
+    fn pulse_period_from_rising_edges() {
+        // one pulse every 12.5 samples at 1 kHz: 12.5 ms, located to a fraction of a sample
+        let tach: Vec<f64> = (0..200)
+            .map(|k| if (k as f64 % 12.5) < 2.0 { 1.0 } else { 0.0 })
+            .collect();
+        let s = Signals::new(vec!["tach".into()], 1000.0, vec![tach]).unwrap();
+        let period = s.pulse_period_s(0).unwrap();
+        // edges at integer samples only: the mean over 15 intervals is within 1/15 sample
+        assert!((period - 12.5e-3).abs() < 1e-3 / 15.0, "{period}");
+        let flat = Signals::new(vec!["tach".into()], 1000.0, vec![vec![0.0; 10]]).unwrap();
+        assert!(flat.pulse_period_s(0).is_err());
+        assert!(s.pulse_period_s(3).is_err());
     }
 }

@@ -207,12 +207,13 @@ pub fn sample_boundaries<S: StabilitySolver + ?Sized>(
     let rows = thetas
         .par_iter()
         .map(|theta| {
-            let m = model.perturbed(parameters, theta).map_err(|e| {
-                UncertaintyError::InvalidInput {
-                    field: "samples",
-                    message: e.to_string(),
-                }
-            })?;
+            let m =
+                model
+                    .perturbed(parameters, theta)
+                    .map_err(|e| UncertaintyError::InvalidInput {
+                        field: "samples",
+                        message: e.to_string(),
+                    })?;
             let row = speeds_rpm
                 .iter()
                 .map(|&s| limiting_depth(solver, &m, s, options))

@@ -75,7 +75,10 @@ impl ParameterDistribution {
                 format!("the covariance must be a {d} x {d} matrix (one row per parameter)"),
             ));
         }
-        if let Some(bad) = samples.as_ref().and_then(|s| s.iter().find(|r| r.len() != d)) {
+        if let Some(bad) = samples
+            .as_ref()
+            .and_then(|s| s.iter().find(|r| r.len() != d))
+        {
             return Err(invalid(
                 source,
                 format!("a sample has {} values, expected {d}", bad.len()),
@@ -120,9 +123,7 @@ impl ParameterDistribution {
         let text = read(path)?;
         let f: CovarianceFile =
             serde_json::from_str(&text).map_err(|e| invalid(path, e.to_string()))?;
-        let mean = f
-            .mean
-            .unwrap_or_else(|| vec![0.0; f.parameter_names.len()]);
+        let mean = f.mean.unwrap_or_else(|| vec![0.0; f.parameter_names.len()]);
         Self::new(&f.parameter_names, mean, f.covariance, None, path)
     }
 
@@ -213,7 +214,10 @@ fn read_samples(path: &Path, names: &[String]) -> Result<Vec<Vec<f64>>> {
                     rec.get(c)
                         .and_then(|v| v.trim().parse::<f64>().ok())
                         .ok_or_else(|| {
-                            invalid(path, format!("row {}: `{}` is not a number", row + 2, &header[c]))
+                            invalid(
+                                path,
+                                format!("row {}: `{}` is not a number", row + 2, &header[c]),
+                            )
                         })
                 })
                 .collect()

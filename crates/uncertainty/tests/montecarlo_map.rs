@@ -21,12 +21,24 @@ fn map_of_the_turning_case_is_monotone_and_centred_on_the_mean_boundary() {
     let speeds: Vec<f64> = (0..4).map(|i| 6900.0 + 200.0 * i as f64).collect();
     let options = BoundaryOptions::default();
     let solver = FrequencyDomain;
-    let sampled =
-        sample_boundaries(&solver, &model, &params, &thetas, &speeds, &options, &|_, _| {})
-            .unwrap();
-    let nominal =
-        lobe_diagram(&solver, &model, &speeds, &options, &chatter_stability::boundary::Silent)
-            .unwrap();
+    let sampled = sample_boundaries(
+        &solver,
+        &model,
+        &params,
+        &thetas,
+        &speeds,
+        &options,
+        &|_, _| {},
+    )
+    .unwrap();
+    let nominal = lobe_diagram(
+        &solver,
+        &model,
+        &speeds,
+        &options,
+        &chatter_stability::boundary::Silent,
+    )
+    .unwrap();
     let depths: Vec<f64> = (0..=80).map(|j| 0.1 * j as f64).collect();
     let map = sampled.stability_map(&depths);
     let median = sampled.probability_contour(0.5);
@@ -46,5 +58,8 @@ fn map_of_the_turning_case_is_monotone_and_centred_on_the_mean_boundary() {
         );
     }
     // Same seed, same draws.
-    assert_eq!(thetas, gaussian_draws(&[0.0, 0.0], &sigma, 200, 11).unwrap());
+    assert_eq!(
+        thetas,
+        gaussian_draws(&[0.0, 0.0], &sigma, 200, 11).unwrap()
+    );
 }

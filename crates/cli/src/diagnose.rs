@@ -1,0 +1,238 @@
+//! `chatter diagnose`: the sim-to-real gap between a model and shop-floor observations.
+
+use crate::output::write_atomic;
+use crate::plot::{Markers, Series, line_chart};
+use crate::{inputs, progress::Bar};
+use anyhow::{Context, Result};
+use chatter_gap::{
+    DiagnoseOptions, Diagnosis, DiagnosisObserver, EffectClass, Validation, diagnose,
+};
+use plotters::style::{BLUE, RED};
+use std::io::Write;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Held-out validation schemes of the CLI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ValidationArg {
+    /// Random folds.
+    Kfold,
+    /// Leave one speed band out.
+    SpeedBands,
+    /// No validation.
+    Off,
+}
+
+/// What `chatter diagnose` was asked.
+pub struct DiagnoseRequest<'a> {
+    pub model: &'a Path,
+    pub observations: &'a Path,
+    pub seed: u64,
+    pub samples: usize,
+    pub validation: ValidationArg,
+    pub folds: usize,
+    pub out: Option<&'a Path>,
+    pub quiet: bool,
+}
+
+/// What stdout gets: the diagnosis without the per-observation residuals (those go to
+/// `diagnosis.json` under `--out`).
+#[derive(serde::Serialize)]
+struct Report<'a> {
+    verdict: &'static str,
+    best_class: EffectClass,
+    classes: &'a [chatter_gap::diagnose::ClassReport],
+    regions: &'a [chatter_gap::regions::Region],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shrink: Option<&'a chatter_gap::shrink::Shrink>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    validation: Option<&'a chatter_gap::shrink::ValidationReport>,
+    predictive_check: &'a chatter_gap::PredictiveCheck,
+    notes: &'a [String],
+}
+
+/// Progress over the classes and the validation folds.
+struct Progress {
+    bar: Bar,
+    done: AtomicUsize,
+}
+
+impl DiagnosisObserver for Progress {
+    fn class_done(&self, _class: EffectClass, _log_evidence: f64) {
+        let k = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        self.bar.set(k);
+    }
+    fn fold_done(&self, _done: usize, _total: usize) {
+        let k = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        self.bar.set(k);
+    }
+}
+
+/// `chatter diagnose`: the report JSON on stdout.
+pub fn run(r: &DiagnoseRequest) -> Result<()> {
+    let (_, json) = report(r)?;
+    let mut stdout = std::io::stdout().lock();
+    writeln!(stdout, "{json}").context("writing to stdout")
+}
+
+/// The diagnosis and its report JSON; with `out`, also `diagnosis.json`, `lobes.svg` and
+/// `residuals.svg` there.
+pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String)> {
+    let model = inputs::model(r.model)?;
+    let observations = inputs::observations(r.observations)?;
+    let validation = match r.validation {
+        ValidationArg::Kfold => Validation::KFold { folds: r.folds },
+        ValidationArg::SpeedBands => Validation::SpeedBands { bands: r.folds },
+        ValidationArg::Off => Validation::Off,
+    };
+    let options = DiagnoseOptions {
+        seed: r.seed,
+        samples: r.samples,
+        validation,
+        ..DiagnoseOptions::default()
+    };
+    let folds = if validation == Validation::Off {
+        0
+    } else {
+        r.folds
+    };
+    let progress = Progress {
+        bar: Bar::new(
+            (EffectClass::ALL.len() + folds) as u64,
+            "diagnosing",
+            r.quiet,
+        ),
+        done: AtomicUsize::new(0),
+    };
+    let diagnosis = diagnose(&model, &observations, &options, &progress).with_context(|| {
+        format!(
+            "diagnosing {} against {}",
+            r.observations.display(),
+            r.model.display()
+        )
+    })?;
+    progress.bar.finish();
+    let d = &diagnosis;
+    let report = Report {
+        verdict: d.verdict.name(),
+        best_class: d.best_class,
+        classes: &d.classes,
+        regions: &d.regions,
+        shrink: d.shrink.as_ref(),
+        validation: d.validation.as_ref(),
+        predictive_check: &d.predictive_check,
+        notes: &d.notes,
+    };
+    if let Some(dir) = r.out {
+        let full = serde_json::to_string_pretty(&diagnosis)?;
+        write_atomic(&dir.join("diagnosis.json"), full.as_bytes())?;
+        lobe_plot(&diagnosis, &dir.join("lobes.svg"))?;
+        residual_map(&diagnosis, &dir.join("residuals.svg"))?;
+    }
+    let json = serde_json::to_string_pretty(&report)?;
+    Ok((diagnosis, json))
+}
+
+/// Lobes of the nominal and the diagnosed model over the observed cuts.
+fn lobe_plot(d: &Diagnosis, path: &Path) -> Result<()> {
+    let cuts = &d.residuals.nominal.cuts;
+    let (lo, hi) = cuts
+        .iter()
+        .map(|c| c.speed_rpm)
+        .fold((f64::INFINITY, 0.0f64), |(a, b), s| (a.min(s), b.max(s)));
+    let (lo, hi) = if lo < hi {
+        (lo, hi)
+    } else {
+        (0.8 * hi.max(1.0), 1.2 * hi.max(1.0))
+    };
+    let speeds: Vec<f64> = (0..400)
+        .map(|i| lo + (hi - lo) * i as f64 / 399.0)
+        .collect();
+    let lobes = d.lobes(&speeds);
+    let series = [
+        Series {
+            label: "nominal".into(),
+            points: lobes.iter().map(|l| (l.speed_rpm, l.nominal_mm)).collect(),
+            color: BLUE,
+            dashed: false,
+        },
+        Series {
+            label: format!("diagnosed ({})", d.best_class),
+            points: lobes
+                .iter()
+                .map(|l| (l.speed_rpm, l.diagnosed_mm))
+                .collect(),
+            color: RED,
+            dashed: false,
+        },
+    ];
+    let markers = Markers {
+        stable: cuts
+            .iter()
+            .filter(|c| c.stable)
+            .map(|c| (c.speed_rpm, c.depth_mm))
+            .collect(),
+        unstable: cuts
+            .iter()
+            .filter(|c| !c.stable)
+            .map(|c| (c.speed_rpm, c.depth_mm))
+            .collect(),
+    };
+    line_chart(
+        path,
+        &format!("verdict: {}", d.verdict.name()),
+        "spindle speed (rpm)",
+        "limiting depth (mm)",
+        &series,
+        Some(&markers),
+    )
+}
+
+/// Every cut at its depth over the nominal limit: circles above 1 and crosses below 1 disagree
+/// with the nominal model; the diagnosed limit over the nominal one is drawn as dots.
+fn residual_map(d: &Diagnosis, path: &Path) -> Result<()> {
+    let nominal = &d.residuals.nominal.cuts;
+    let diagnosed = &d.residuals.diagnosed.cuts;
+    let ratio = |c: &chatter_gap::regions::CutResidual| (c.speed_rpm, c.depth_mm / c.limit_mm);
+    let mut speeds: Vec<f64> = nominal.iter().map(|c| c.speed_rpm).collect();
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup();
+    let line = Series {
+        label: "nominal limit".into(),
+        points: speeds.iter().map(|&s| (s, 1.0)).collect(),
+        color: BLUE,
+        dashed: false,
+    };
+    let diagnosed_limit = Series {
+        label: "diagnosed limit / nominal limit".into(),
+        points: nominal
+            .iter()
+            .zip(diagnosed)
+            .map(|(n, g)| (n.speed_rpm, g.limit_mm / n.limit_mm))
+            .collect(),
+        color: RED,
+        dashed: true,
+    };
+    let markers = Markers {
+        stable: nominal
+            .iter()
+            .filter(|c| c.stable)
+            .map(ratio)
+            .filter(|p| p.1.is_finite())
+            .collect(),
+        unstable: nominal
+            .iter()
+            .filter(|c| !c.stable)
+            .map(ratio)
+            .filter(|p| p.1.is_finite())
+            .collect(),
+    };
+    line_chart(
+        path,
+        "cuts relative to the nominal boundary",
+        "spindle speed (rpm)",
+        "depth / nominal limiting depth",
+        &[line, diagnosed_limit],
+        Some(&markers),
+    )
+}

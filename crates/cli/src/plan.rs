@@ -1,0 +1,131 @@
+//! `chatter plan`: the next test cut as JSON, by value of information (003) or by maximum
+//! material removal rate on a probability-of-stability contour (004).
+
+use crate::progress::Bar;
+use anyhow::{Context, Result};
+use chatter_updating::ensemble::EnsembleObserver;
+use chatter_updating::parameters::parse_model_parameters;
+use chatter_updating::plan::{PlanSettings, Strategy, plan_next_cut};
+use chatter_updating::update::PriorOverrides;
+use std::path::PathBuf;
+
+/// Test-selection strategies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StrategyArg {
+    /// Largest expected reduction of a parameter's uncertainty (003).
+    Voi,
+    /// Largest material removal rate on the P_test contour (004).
+    Mrr,
+}
+
+/// Arguments of `chatter plan`.
+#[derive(Debug, clap::Args)]
+pub struct PlanArgs {
+    /// Model file (JSON).
+    #[arg(long)]
+    model: PathBuf,
+    /// Cuts made so far (JSON or cuts CSV).
+    #[arg(long)]
+    observations: PathBuf,
+    /// voi (003) or mrr (004).
+    #[arg(long, value_enum)]
+    strategy: StrategyArg,
+    /// Probability of stability of the tested contour (mrr).
+    #[arg(long, default_value_t = 0.5)]
+    p_test: f64,
+    /// Sampled parameters, comma-separated; default kt_n_per_mm2,kn_n_per_mm2 (+ c_n_per_m with
+    /// process damping).
+    #[arg(long)]
+    parameters: Option<String>,
+    /// Priors file (as for `chatter update`).
+    #[arg(long)]
+    priors: Option<PathBuf>,
+    /// The parameter whose uncertainty value of information reduces; default c_n_per_m when
+    /// sampled, else the first parameter.
+    #[arg(long)]
+    target: Option<String>,
+    /// Sampled stability boundaries.
+    #[arg(long, default_value_t = 300)]
+    paths: usize,
+    /// Candidate speeds MIN:MAX:N (rpm); default the cut speeds +- 25 %.
+    #[arg(long)]
+    speeds: Option<String>,
+    /// Candidate depths MIN:MAX:N (mm); default up to twice the deepest cut.
+    #[arg(long)]
+    depths: Option<String>,
+    /// Feed per tooth (mm) for the material removal rate.
+    #[arg(long, default_value_t = 0.1)]
+    feed_per_tooth_mm: f64,
+    /// Seed of the prior samples.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+struct PathProgress(Bar);
+
+impl EnsembleObserver for PathProgress {
+    fn paths_done(&self, done: usize, _total: usize) {
+        self.0.set(done);
+    }
+}
+
+/// Run `chatter plan`: print the next cut as JSON on stdout.
+pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
+    let model = crate::inputs::model(&args.model)?;
+    let observations = crate::inputs::observations(&args.observations)?;
+    let priors: PriorOverrides = match &args.priors {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading the priors file {}", path.display()))?;
+            serde_json::from_str(&text)
+                .with_context(|| format!("{}: invalid priors file", path.display()))?
+        }
+        None => PriorOverrides::new(),
+    };
+    let settings = PlanSettings {
+        strategy: match args.strategy {
+            StrategyArg::Voi => Strategy::ValueOfInformation,
+            StrategyArg::Mrr => Strategy::MaterialRemovalRate,
+        },
+        p_test: args.p_test,
+        parameters: args
+            .parameters
+            .as_deref()
+            .map(parse_model_parameters)
+            .transpose()?,
+        priors,
+        target: args.target.as_deref().map(str::parse).transpose()?,
+        paths: args.paths,
+        speeds_rpm: args
+            .speeds
+            .as_deref()
+            .map(crate::inputs::speeds)
+            .transpose()?,
+        depths_m: args
+            .depths
+            .as_deref()
+            .map(|s| crate::inputs::grid("--depths", s, 0.0))
+            .transpose()?
+            .map(|d| {
+                d.into_iter()
+                    .filter(|v| *v > 0.0)
+                    .map(|v| v * 1e-3)
+                    .collect()
+            }),
+        feed_per_tooth_m: args.feed_per_tooth_mm * 1e-3,
+        seed: args.seed,
+    };
+    let progress = PathProgress(Bar::new(args.paths as u64, "sampled boundaries", quiet));
+    let outcome = plan_next_cut(&model, &observations, &settings, &progress)?;
+    progress.0.finish();
+    let strategy = match args.strategy {
+        StrategyArg::Voi => "voi",
+        StrategyArg::Mrr => "mrr",
+    };
+    let mut json = serde_json::to_value(&outcome)?;
+    if let Some(map) = json.as_object_mut() {
+        map.insert("strategy".into(), strategy.into());
+    }
+    println!("{}", serde_json::to_string_pretty(&json)?);
+    Ok(())
+}
