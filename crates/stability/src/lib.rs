@@ -10,6 +10,7 @@
 pub mod boundary;
 pub mod error;
 pub mod frequency_domain;
+mod hessenberg;
 pub mod monodromy;
 pub mod multiplier;
 pub mod process_damping;

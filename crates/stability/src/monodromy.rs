@@ -35,6 +35,7 @@
 
 use crate::StabilitySolver;
 use crate::error::{Result, StabilityError, check_condition};
+use crate::hessenberg::hessenberg_eigenvalues;
 use crate::multiplier::DominantMultiplier;
 use chatter_dynamics::{ModalModel, Operation};
 use nalgebra::{DMatrix, DVector};
@@ -562,21 +563,40 @@ impl Monodromy {
 
     /// Apply the monodromy: `out` = U `x` (both of [`Self::dimension`]).
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
-        let n = self.modes;
-        let s2 = 2 * n;
-        let mut y = x[..s2].to_vec();
-        let mut next = vec![0.0; s2];
+        // literal state sizes let the compiler unroll the small block products of `sweep`
+        match 2 * self.modes {
+            2 => self.sweep(2, x, out),
+            4 => self.sweep(4, x, out),
+            6 => self.sweep(6, x, out),
+            8 => self.sweep(8, x, out),
+            s2 => self.sweep(s2, x, out),
+        }
+    }
+
+    /// The step program of [`Self::apply`] for the state size `s2` = 2N: each step
+    /// y' = P y + R q_a + S q_b, with the delayed displacements q read from `x` and the current
+    /// displacement stored as the new delayed value of its grid point.
+    #[inline(always)]
+    fn sweep(&self, s2: usize, x: &[f64], out: &mut [f64]) {
+        const INLINE: usize = 16;
+        let n = s2 / 2;
+        let mut stack = [0.0; 2 * INLINE];
+        let mut heap = Vec::new();
+        let (mut y, mut next) = if s2 <= INLINE {
+            let (a, b) = stack.split_at_mut(INLINE);
+            (&mut a[..s2], &mut b[..s2])
+        } else {
+            heap.resize(2 * s2, 0.0);
+            heap.split_at_mut(s2)
+        };
+        y.copy_from_slice(&x[..s2]);
         for step in &self.steps {
             let a = s2 + step.start * n;
             // the new delayed value at this grid point is the current displacement
             out[a..a + n].copy_from_slice(&y[..n]);
             let (p, r, s) = self.blocks(step);
-            for (i, nx) in next.iter_mut().enumerate() {
-                *nx = p[i * s2..(i + 1) * s2]
-                    .iter()
-                    .zip(&y)
-                    .map(|(pij, yj)| pij * yj)
-                    .sum();
+            for (nx, row) in next.iter_mut().zip(p.chunks_exact(s2)) {
+                *nx = row.iter().zip(y.iter()).map(|(pij, yj)| pij * yj).sum();
             }
             if step.cutting {
                 let qa = &x[a..a + n];
@@ -586,15 +606,19 @@ impl Monodromy {
                 } else {
                     &x[a + n..a + 2 * n]
                 };
-                for (i, nx) in next.iter_mut().enumerate() {
+                for ((nx, ri), si) in next
+                    .iter_mut()
+                    .zip(r.chunks_exact(n))
+                    .zip(s.chunks_exact(n))
+                {
                     for j in 0..n {
-                        *nx += r[i * n + j] * qa[j] + s[i * n + j] * qb[j];
+                        *nx += ri[j] * qa[j] + si[j] * qb[j];
                     }
                 }
             }
             std::mem::swap(&mut y, &mut next);
         }
-        out[..s2].copy_from_slice(&y);
+        out[..s2].copy_from_slice(y);
     }
 
     /// Apply the transpose: `out` = U^T `x`, the reverse sweep of the step program of
@@ -717,8 +741,11 @@ impl Monodromy {
             .into_iter()
             .filter(|f| *f >= band_hz.0 && *f <= band_hz.1)
             .map(|f| {
+                // |V(f)|^2 + |V(-f)|^2: the same for the eigenvector of either member of a
+                // complex-conjugate pair of multipliers
                 let amplitude: f64 = (0..n)
-                    .map(|j| {
+                    .flat_map(|j| [(j, f), (j, -f)])
+                    .map(|(j, f)| {
                         let sum: Complex64 = (0..self.grid)
                             .map(|k| {
                                 let phase = -2.0 * PI * f * times[k];
@@ -753,12 +780,25 @@ fn dense_eigenpair(dense: DMatrix<f64>) -> Result<(Complex64, Vec<Complex64>)> {
     Ok((mu, x.iter().copied().collect()))
 }
 
+/// The eigenvalue of largest modulus; of a complex-conjugate pair, the member with Im >= 0.
 fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
-    values
-        .iter()
-        .copied()
-        .filter(|z| z.re.is_finite() && z.im.is_finite())
-        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+    let finite = || {
+        values
+            .iter()
+            .copied()
+            .filter(|z| z.re.is_finite() && z.im.is_finite())
+    };
+    let top =
+        finite()
+            .map(|z| z.norm())
+            .max_by(f64::total_cmp)
+            .ok_or(StabilityError::NoConvergence {
+                solver: "eigenvalues",
+                detail: "no finite eigenvalue".into(),
+            })?;
+    finite()
+        .filter(|z| z.norm() >= top * (1.0 - 1e-12))
+        .max_by(|a, b| a.im.total_cmp(&b.im))
         .ok_or(StabilityError::NoConvergence {
             solver: "eigenvalues",
             detail: "no finite eigenvalue".into(),
@@ -769,7 +809,7 @@ fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
 const ARNOLDI_DIM: usize = 20;
 /// Krylov dimensions within a cycle at which convergence is tested (the small Hessenberg
 /// eigenproblem costs O(k^3), so most operators stop well before [`ARNOLDI_DIM`]).
-const ARNOLDI_CHECKS: [usize; 4] = [8, 12, 16, ARNOLDI_DIM];
+const ARNOLDI_CHECKS: [usize; 3] = [9, 14, ARNOLDI_DIM];
 /// Maximum restarts.
 const ARNOLDI_RESTARTS: usize = 40;
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
@@ -778,10 +818,15 @@ const ARNOLDI_TOL: f64 = 1e-10;
 /// The dominant Ritz pair of the leading kk x kk block of `h`: value, the small eigenvector and
 /// the residual estimate |h_{kk+1,kk} x_kk|.
 fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex64>, f64)> {
-    let hk = h.view((0, 0), (kk, kk)).into_owned();
-    let theta = largest(&hk.complex_eigenvalues())?;
+    let mut rows: Vec<f64> = (0..kk * kk).map(|k| h[(k / kk, k % kk)]).collect();
+    let values =
+        hessenberg_eigenvalues(&mut rows, kk).ok_or_else(|| StabilityError::NoConvergence {
+            solver: "Hessenberg QR",
+            detail: format!("{kk} x {kk} Arnoldi matrix"),
+        })?;
+    let theta = largest(&DVector::from_vec(values))?;
     // Ritz vector of theta by inverse iteration on the small Hessenberg matrix
-    let hc = hk.map(|x| Complex64::new(x, 0.0));
+    let hc = h.view((0, 0), (kk, kk)).map(|x| Complex64::new(x, 0.0));
     let shift = theta * Complex64::new(1.0 + 1e-10, 0.0);
     let lu = (hc - DMatrix::identity(kk, kk) * shift).lu();
     let mut x = DVector::from_element(kk, Complex64::new(1.0, 0.0));
@@ -824,8 +869,11 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
         let mut h = DMatrix::<f64>::zeros(k + 1, k);
         for j in 0..k {
             apply(&v[j], &mut w);
-            // modified Gram-Schmidt, twice for stability
+            // modified Gram-Schmidt, repeated when it cancels most of w (Daniel, Gragg,
+            // Kaufman and Stewart 1976: reorthogonalize when the norm drops below 1/sqrt(2))
+            let mut norm2 = w.iter().map(|x| x * x).sum::<f64>();
             for _ in 0..2 {
+                let before = norm2;
                 for (i, vi) in v.iter().enumerate().take(j + 1) {
                     let c: f64 = vi.iter().zip(&w).map(|(a, b)| a * b).sum();
                     h[(i, j)] += c;
@@ -833,8 +881,12 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
                         *wx -= c * vx;
                     }
                 }
+                norm2 = w.iter().map(|x| x * x).sum::<f64>();
+                if norm2 > 0.5 * before {
+                    break;
+                }
             }
-            let beta = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let beta = norm2.sqrt();
             h[(j + 1, j)] = beta;
             let kk = j + 1;
             let breakdown = beta < 1e-14;

@@ -24,10 +24,12 @@
 //! stops when the next test would improve the best stable MRR by less than 10 %.
 
 use crate::boundary::{BoundaryOptions, limiting_depth};
-use crate::cuts::CutKernel;
+use crate::classes::{Sampler, SamplerOptions, sample_posterior};
+use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_bayes::Prior;
+use chatter_bayes::samples::SampleSet;
 use chatter_dynamics::{Cut, ModalModel, Operation};
 use chatter_stability::boundary::LobePoint;
 use rand::SeedableRng;
@@ -141,6 +143,81 @@ impl BoundaryEnsemble {
         };
         ensemble.add_speeds(speeds_rpm, observer)?;
         Ok(ensemble)
+    }
+
+    /// Paths from a weighted posterior sample set (e.g. the unique samples of adaptive MCMC with
+    /// their multiplicities), P_i proportional to the weights.
+    pub fn from_sample_set(
+        parameterization: Parameterization,
+        set: &SampleSet,
+        speeds_rpm: &[f64],
+        options: BoundaryOptions,
+        observer: &dyn EnsembleObserver,
+    ) -> Result<Self> {
+        let mut ensemble = Self::from_samples(
+            parameterization,
+            set.samples().to_vec(),
+            speeds_rpm,
+            options,
+            observer,
+        )?;
+        let total: f64 = set.weights().iter().sum();
+        ensemble.ln_weights = set.weights().iter().map(|w| (w / total).ln()).collect();
+        Ok(ensemble)
+    }
+
+    /// Paths drawn from the posterior given the cuts made so far (004 Section 5): prior draws
+    /// filtered by rejection sampling with the cut-result likelihood (004 Eq. 5-7), then parallel
+    /// adaptive MCMC (Eq. 8) until `paths` unique samples. Unlike [`Self::update`], which
+    /// reweights fixed prior paths (003), the paths follow the posterior however many cuts have
+    /// been made. Without cuts, `paths` prior draws. Where rejection sampling keeps too few prior
+    /// draws to start the chains (a sharply peaked likelihood), iTMCMC draws the paths instead.
+    #[allow(clippy::too_many_arguments)]
+    pub fn from_posterior<P: Prior>(
+        parameterization: Parameterization,
+        prior: &P,
+        cuts: &[Cut],
+        kernel: &CutKernel,
+        paths: usize,
+        speeds_rpm: &[f64],
+        options: BoundaryOptions,
+        seed: u64,
+        observer: &dyn EnsembleObserver,
+    ) -> Result<Self> {
+        if cuts.is_empty() {
+            return Self::from_prior(
+                parameterization,
+                prior,
+                paths,
+                speeds_rpm,
+                options,
+                seed,
+                observer,
+            );
+        }
+        let likelihood =
+            CutsLikelihood::new(parameterization.clone(), cuts.to_vec(), *kernel, options)?;
+        let draw = |sampler| {
+            let settings = SamplerOptions {
+                sampler,
+                samples: paths,
+                seed,
+            };
+            sample_posterior(prior, &likelihood, &settings, &crate::classes::Silent)
+        };
+        let posterior = match draw(Sampler::Amcmc) {
+            Err(UpdatingError::InvalidInput {
+                field: "samples", ..
+            }) => draw(Sampler::Itmcmc)?,
+            other => other?,
+        };
+        Self::from_sample_set(
+            parameterization,
+            &posterior.samples,
+            speeds_rpm,
+            options,
+            observer,
+        )
     }
 
     /// `paths` samples drawn from `prior` (path i from its own stream of `seed`).

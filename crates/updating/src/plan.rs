@@ -1,6 +1,7 @@
-//! The next test cut (what `chatter plan` runs): sampled boundaries from the priors, updated with
-//! the cuts made so far, then value of information (003) or risk-based selection at maximum
-//! material removal rate (004), with the papers' stopping rules.
+//! The next test cut (what `chatter plan` runs): sampled boundaries given the cuts made so far,
+//! then value of information (003: prior paths reweighted by the cuts) or risk-based selection at
+//! maximum material removal rate (004: paths drawn from the posterior by rejection sampling and
+//! parallel adaptive MCMC), with the papers' stopping rules.
 
 use crate::boundary::BoundaryOptions;
 use crate::cuts::CutKernel;
@@ -164,18 +165,36 @@ pub fn plan_next_cut(
         Strategy::ValueOfInformation => CutKernel::karandikar(),
         Strategy::MaterialRemovalRate => CutKernel::schmitz(),
     };
-    let mut ensemble = BoundaryEnsemble::from_prior(
-        p.clone(),
-        &prior,
-        settings.paths,
-        &speeds,
-        options,
-        settings.seed,
-        observer,
-    )?;
-    for cut in &observations.cuts {
-        ensemble.update(cut, &kernel)?;
-    }
+    let ensemble = match settings.strategy {
+        // 003: fixed prior paths, reweighted by every cut
+        Strategy::ValueOfInformation => {
+            let mut ensemble = BoundaryEnsemble::from_prior(
+                p.clone(),
+                &prior,
+                settings.paths,
+                &speeds,
+                options,
+                settings.seed,
+                observer,
+            )?;
+            for cut in &observations.cuts {
+                ensemble.update(cut, &kernel)?;
+            }
+            ensemble
+        }
+        // 004: paths drawn from the posterior by rejection sampling and adaptive MCMC
+        Strategy::MaterialRemovalRate => BoundaryEnsemble::from_posterior(
+            p.clone(),
+            &prior,
+            &observations.cuts,
+            &kernel,
+            settings.paths,
+            &speeds,
+            options,
+            settings.seed,
+            observer,
+        )?,
+    };
     let moments = (0..p.dimension())
         .map(|k| ensemble.moments(k))
         .collect::<Result<Vec<_>>>()?;

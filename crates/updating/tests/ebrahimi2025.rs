@@ -121,3 +121,88 @@ fn simulated_poles_bring_the_parameters_back_to_nominal() {
     assert!(m[0].abs() < 0.002 && m[1].abs() < 0.1 && m[2].abs() < 0.06);
     assert!(c[(0, 0)] < 0.01 * c[(1, 1)].min(c[(2, 2)]));
 }
+
+/// Seed 002, experimental case (Section 3.2): the hammer-test model (195.3 Hz, zeta 0.004,
+/// 2.34 N/um) updated from the Table 2 poles with the paper's uniform priors (theta_omega and
+/// theta_k on +-0.1, theta_zeta on +-0.5, sigma_w^2 on (0, 1]) and the exact monodromy likelihood.
+///
+/// The paper selects alpha = 0.006 and reports the mean (3.6e-3, 0.35, 0.003); we select
+/// alpha = 0.1 with mean about (0.016, 0.49, -0.099), theta_zeta and theta_k near their prior
+/// bounds. The difference lies in the data rather than the sampler: the Table 2 damping ratios of
+/// P1-P3 (0.088, 0.0722, 0.0501) and four of its standard deviations repeat Table 1 (the
+/// simulation) digit for digit, and the paper's own posterior mean predicts P1-P3 at 13.3-13.6 Hz
+/// where the table has 10.6-11.5 Hz (in the simulated case, too, Table 1 sits a constant 1.2 Hz
+/// below the monodromy poles of the stated model while its damping ratios agree). What the update
+/// must do regardless is asserted: it pulls the predicted poles onto the identified frequencies
+/// and turns the model's verdict on the seven stable cuts from mostly unstable to stable.
+#[test]
+fn experimental_update_fits_the_identified_poles_and_the_stable_cuts() {
+    use chatter_dynamics::examples;
+    use chatter_stability::StabilitySolver;
+    use chatter_updating::update::{UpdateJob, UpdateSettings};
+
+    let model = examples::ebrahimi_2025_milling();
+    let obs = examples::ebrahimi_2025_milling_observations();
+    let settings = UpdateSettings {
+        classes: Some(vec![0.01, 0.1, 1.0]),
+        ..Default::default()
+    };
+    let job = UpdateJob::new(&model, &obs, &settings).unwrap();
+    assert_eq!(
+        job.parameter_names(),
+        ["theta_omega_1", "theta_zeta_1", "theta_k_1", "sigma_w2_hz2"]
+    );
+    let options = SamplerOptions {
+        sampler: Sampler::Tmcmc,
+        samples: 200,
+        seed: 3,
+    };
+    let result = job.run(&options, &Silent).unwrap();
+    let evidence: Vec<f64> = result.classes.iter().map(|c| c.log_evidence).collect();
+    let m = &result.posterior_mean;
+    eprintln!(
+        "log evidence {evidence:.1?}, alpha {:?}, mean {m:.4?}",
+        result.selected_alpha
+    );
+    // an interior evidence maximum
+    assert_eq!(result.selected_alpha, Some(0.1));
+    assert!(evidence[1] > evidence[0] + 50.0 && evidence[1] > evidence[2] + 50.0);
+    // the natural frequency rose (the paper's theta_omega is positive too)
+    assert!(m[0] > 0.005 && m[0] < 0.03, "{}", m[0]);
+
+    let p = Parameterization::new(
+        model.clone(),
+        parse_model_parameters("theta_omega_1,theta_zeta_1,theta_k_1").unwrap(),
+    )
+    .unwrap();
+    let like = MillingPoleLikelihood::new(p, &obs.poles, 0.1, Discretization::full()).unwrap();
+    let rms = |theta: &[f64]| {
+        let predicted = like.predicted_poles(theta).unwrap();
+        let sum: f64 = predicted
+            .iter()
+            .zip(&obs.poles)
+            .map(|((f, _), o)| (f - o.frequency_hz).powi(2))
+            .sum();
+        (sum / predicted.len() as f64).sqrt()
+    };
+    let (before, after) = (rms(&[0.0, 0.0, 0.0]), rms(&m[..3]));
+    eprintln!("rms frequency error: hammer model {before:.2} Hz, updated {after:.2} Hz");
+    assert!(before > 2.0 && after < 0.2 * before);
+
+    // the seven cuts P1-P7 were all stable
+    let stable_count = |model: &ModalModel| {
+        obs.cuts
+            .iter()
+            .filter(|c| {
+                let mu = Discretization::full()
+                    .dominant_multiplier(model, c.speed_rpm, c.depth_mm * 1e-3)
+                    .unwrap();
+                mu.modulus() < 1.0
+            })
+            .count()
+    };
+    assert!(obs.cuts.iter().all(|c| c.stable) && obs.cuts.len() == 7);
+    let (nominal, updated) = (stable_count(&model), stable_count(&result.updated_model));
+    eprintln!("stable cuts predicted stable: hammer model {nominal}/7, updated {updated}/7");
+    assert!(nominal <= 2 && updated >= 6);
+}

@@ -1,7 +1,8 @@
 //! Seed 004: risk-based test selection. On a synthetic machine with known parameters, tests are
 //! chosen at the maximum material removal rate on the P_s = 50 % contour of the current sampled
-//! boundaries, each result (stable, or chatter with its frequency) updates the samples with
-//! 004 Eq. 5 (s_S = 0.125 mm, s_fc = 50 Hz), and testing stops when the next test would improve
+//! boundaries; after each result (stable, or chatter with its frequency) the samples are drawn
+//! anew from the posterior of 004 Eq. 5-7 (s_S = 0.125 mm, s_fc = 50 Hz) by rejection sampling
+//! and parallel adaptive MCMC (004 Section 5), and testing stops when the next test would improve
 //! the best stable MRR by less than 10 %. The true boundary comes from the zero-order lobes of
 //! `chatter-stability`.
 
@@ -90,7 +91,8 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
         ..Default::default()
     };
     let mut samples =
-        BoundaryEnsemble::from_prior(p, &prior, 300, &speeds, options, 5, &Silent).unwrap();
+        BoundaryEnsemble::from_prior(p.clone(), &prior, 300, &speeds, options, 5, &Silent).unwrap();
+    let mut cuts = Vec::new();
     let kernel = CutKernel::schmitz();
     let mut best_stable: f64 = 0.0;
     let mut tests = 0;
@@ -117,7 +119,20 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
             radial_immersion: None,
             note: None,
         };
-        samples.update(&cut, &kernel).unwrap();
+        cuts.push(cut);
+        // 004 Section 5: the next boundaries come from the posterior given every cut so far
+        samples = BoundaryEnsemble::from_posterior(
+            p.clone(),
+            &prior,
+            &cuts,
+            &kernel,
+            300,
+            &speeds,
+            options,
+            5,
+            &Silent,
+        )
+        .unwrap();
         tests += 1;
         if stable {
             best_stable = best_stable.max(plan_mrr);
