@@ -8,6 +8,26 @@ fn chatter() -> Command {
     Command::new(env!("CARGO_BIN_EXE_chatter"))
 }
 
+/// Run, require exit status 0 and return stdout (stderr in the failure message).
+fn succeed(command: &mut Command) -> String {
+    let out = command.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Run, require exit status 1 (bad input) and return stderr, which must not be a panic.
+fn fail(command: &mut Command) -> String {
+    let out = command.output().unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
 fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -16,13 +36,11 @@ fn example(name: &str) -> PathBuf {
 
 #[test]
 fn frf_csv_has_header_and_rows() {
-    let out = chatter()
-        .args(["frf", "--points", "50", "--model"])
-        .arg(example("schmitz2023_milling_model.json"))
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = succeed(
+        chatter()
+            .args(["frf", "--points", "50", "--model"])
+            .arg(example("schmitz2023_milling_model.json")),
+    );
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
@@ -37,37 +55,34 @@ fn frf_csv_has_header_and_rows() {
 
 #[test]
 fn lobes_and_multiplier() {
-    let out = chatter()
-        .args([
-            "lobes",
-            "--quiet",
-            "--method",
-            "zoa",
-            "--speeds",
-            "5000:12000:15",
-            "--model",
-        ])
-        .arg(example("schmitz2023_milling_model.json"))
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = succeed(
+        chatter()
+            .args([
+                "lobes",
+                "--quiet",
+                "--method",
+                "zoa",
+                "--speeds",
+                "5000:12000:15",
+                "--model",
+            ])
+            .arg(example("schmitz2023_milling_model.json")),
+    );
     assert!(text.starts_with("speed_rpm,depth_mm,chatter_hz\n"));
     assert_eq!(text.lines().count(), 16);
-    let out = chatter()
-        .args([
-            "multiplier",
-            "--speed-rpm",
-            "7150",
-            "--depth-mm",
-            "2.286",
-            "--model",
-        ])
-        .arg(example("ahmadi2022_turning_model.json"))
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let out = succeed(
+        chatter()
+            .args([
+                "multiplier",
+                "--speed-rpm",
+                "7150",
+                "--depth-mm",
+                "2.286",
+                "--model",
+            ])
+            .arg(example("ahmadi2022_turning_model.json")),
+    );
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
     let modulus = json["modulus"].as_f64().unwrap();
     assert!(
         modulus > 0.0 && modulus < 1.0,
@@ -83,27 +98,22 @@ fn simulate_writes_csv_and_wav() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["sig.csv", "sig.wav"] {
         let path = dir.path().join(name);
-        let out = chatter()
-            .args([
-                "simulate",
-                "--quiet",
-                "--speed-rpm",
-                "7150",
-                "--depth-mm",
-                "1",
-                "--duration-s",
-                "0.2",
-            ])
-            .args(["--sample-rate-hz", "10000", "--seed", "3", "--model"])
-            .arg(example("ahmadi2022_turning_model.json"))
-            .arg("--out")
-            .arg(&path)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        succeed(
+            chatter()
+                .args([
+                    "simulate",
+                    "--quiet",
+                    "--speed-rpm",
+                    "7150",
+                    "--depth-mm",
+                    "1",
+                    "--duration-s",
+                    "0.2",
+                ])
+                .args(["--sample-rate-hz", "10000", "--seed", "3", "--model"])
+                .arg(example("ahmadi2022_turning_model.json"))
+                .arg("--out")
+                .arg(&path),
         );
         if name.ends_with(".wav") {
             let reader = hound::WavReader::open(&path).unwrap();
@@ -121,16 +131,7 @@ fn simulate_writes_csv_and_wav() {
 #[test]
 fn demo_writes_its_folder() {
     let dir = tempfile::tempdir().unwrap();
-    let out = chatter()
-        .args(["demo", "--quiet", "--out"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeed(chatter().args(["demo", "--quiet", "--out"]).arg(dir.path()));
     for f in [
         "turning_lobes.csv",
         "turning_lobes.svg",
@@ -161,25 +162,20 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         r#"{"operation":{"kind":"milling","teeth":4,"radial_immersion":1.5,"direction":"down"},"cutting":{"kt_n_per_mm2":1,"kn_n_per_mm2":1},"modes":[{"frequency_hz":1,"damping_ratio":0.1,"stiffness_n_per_m":1,"direction":"x"}]}"#,
     )
     .unwrap();
-    let out = chatter()
-        .args(["check", "--model"])
-        .arg(&bad)
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8(out.stderr).unwrap();
+    let err = fail(chatter().args(["check", "--model"]).arg(&bad));
     assert!(
         err.contains("bad.json") && err.contains("radial_immersion"),
         "{err}"
     );
     assert!(!err.contains("panicked"));
-    let out = chatter()
-        .args(["lobes", "--speeds", "1:2", "--model"])
-        .arg(example("schmitz2023_milling_model.json"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8(out.stderr).unwrap().contains("MIN:MAX:N"));
+    assert!(
+        fail(
+            chatter()
+                .args(["lobes", "--speeds", "1:2", "--model"])
+                .arg(example("schmitz2023_milling_model.json"))
+        )
+        .contains("MIN:MAX:N")
+    );
     let missing = chatter()
         .args(["check", "--model", "/nonexistent/model.json"])
         .output()
@@ -213,31 +209,25 @@ fn perturbation_bands_bracket_the_mean() {
     let dir = tempfile::tempdir().unwrap();
     let cov = eq34_covariance(dir.path());
     let plot = dir.path().join("bands.svg");
-    let out = chatter()
-        .args([
-            "bands",
-            "--quiet",
-            "--kind",
-            "perturbation",
-            "--speeds",
-            "7150:7500:3",
-            "--depths",
-            "1.5:4:26",
-            "--covariance",
-        ])
-        .arg(&cov)
-        .arg("--model")
-        .arg(example("ahmadi2022_turning_model.json"))
-        .arg("--plot")
-        .arg(&plot)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let text = succeed(
+        chatter()
+            .args([
+                "bands",
+                "--quiet",
+                "--kind",
+                "perturbation",
+                "--speeds",
+                "7150:7500:3",
+                "--depths",
+                "1.5:4:26",
+                "--covariance",
+            ])
+            .arg(&cov)
+            .arg("--model")
+            .arg(example("ahmadi2022_turning_model.json"))
+            .arg("--plot")
+            .arg(&plot),
     );
-    let text = String::from_utf8(out.stdout).unwrap();
     assert!(
         text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm\n"),
         "{text}"
@@ -260,35 +250,29 @@ fn montecarlo_bands_and_map() {
     let dir = tempfile::tempdir().unwrap();
     let cov = eq34_covariance(dir.path());
     let map = dir.path().join("map.csv");
-    let out = chatter()
-        .args([
-            "bands",
-            "--quiet",
-            "--kind",
-            "montecarlo",
-            "--samples",
-            "24",
-            "--seed",
-            "3",
-            "--speeds",
-            "7150:7500:2",
-            "--depths",
-            "1:4:7",
-            "--covariance",
-        ])
-        .arg(&cov)
-        .arg("--model")
-        .arg(example("ahmadi2022_turning_model.json"))
-        .arg("--map-out")
-        .arg(&map)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let text = succeed(
+        chatter()
+            .args([
+                "bands",
+                "--quiet",
+                "--kind",
+                "montecarlo",
+                "--samples",
+                "24",
+                "--seed",
+                "3",
+                "--speeds",
+                "7150:7500:2",
+                "--depths",
+                "1:4:7",
+                "--covariance",
+            ])
+            .arg(&cov)
+            .arg("--model")
+            .arg(example("ahmadi2022_turning_model.json"))
+            .arg("--map-out")
+            .arg(&map),
     );
-    let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with("speed_rpm,depth_mm,lower_mm,upper_mm,chatter_hz_q05"));
     for r in csv_rows(&text) {
         let (q50, q05, q95) = (r[1].unwrap(), r[2].unwrap(), r[3].unwrap());
@@ -299,13 +283,11 @@ fn montecarlo_bands_and_map() {
     let rows = csv_rows(&grid);
     assert_eq!(rows.len(), 2 * 7);
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[2].unwrap())));
-    let out = chatter()
-        .args(["bands", "--kind", "montecarlo", "--model"])
-        .arg(example("ahmadi2022_turning_model.json"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8(out.stderr).unwrap();
+    let err = fail(
+        chatter()
+            .args(["bands", "--kind", "montecarlo", "--model"])
+            .arg(example("ahmadi2022_turning_model.json")),
+    );
     assert!(
         err.contains("--posterior") && err.contains("--covariance"),
         "{err}"
@@ -329,23 +311,18 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
     std::fs::write(&model_path, nominal.to_json_string()).unwrap();
     std::fs::write(&obs_path, data.to_json_string()).unwrap();
     let out_dir = dir.path().join("gap");
-    let out = chatter()
-        .args([
-            "diagnose", "--quiet", "--seed", "3", "--folds", "3", "--model",
-        ])
-        .arg(&model_path)
-        .arg("--observations")
-        .arg(&obs_path)
-        .arg("--out")
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = succeed(
+        chatter()
+            .args([
+                "diagnose", "--quiet", "--seed", "3", "--folds", "3", "--model",
+            ])
+            .arg(&model_path)
+            .arg("--observations")
+            .arg(&obs_path)
+            .arg("--out")
+            .arg(&out_dir),
     );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(report["verdict"], "process_damping", "{report}");
     let classes = report["classes"].as_array().unwrap();
     assert_eq!(classes.len(), 5);
@@ -385,36 +362,32 @@ fn diagnose_rejects_bad_input() {
         r#"{"signals": [{"file": "s.csv", "speed_rpm": 7000, "depth_mm": 1.0, "sample_rate_hz": 1000}]}"#,
     )
     .unwrap();
-    let out = chatter()
-        .args(["diagnose", "--quiet", "--seed", "1", "--model"])
-        .arg(example("schmitz2023_milling_model.json"))
-        .arg("--observations")
-        .arg(&obs)
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8(out.stderr).unwrap();
+    let err = fail(
+        chatter()
+            .args(["diagnose", "--quiet", "--seed", "1", "--model"])
+            .arg(example("schmitz2023_milling_model.json"))
+            .arg("--observations")
+            .arg(&obs),
+    );
     assert!(
         err.contains("signals_only.json") && err.contains("no cuts and no poles"),
         "{err}"
     );
-    let out = chatter()
-        .args([
-            "diagnose",
-            "--quiet",
-            "--seed",
-            "1",
-            "--samples",
-            "10",
-            "--model",
-        ])
-        .arg(example("schmitz2023_milling_model.json"))
-        .arg("--observations")
-        .arg(example("ebrahimi2025_milling_observations.json"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8(out.stderr).unwrap();
+    let err = fail(
+        chatter()
+            .args([
+                "diagnose",
+                "--quiet",
+                "--seed",
+                "1",
+                "--samples",
+                "10",
+                "--model",
+            ])
+            .arg(example("schmitz2023_milling_model.json"))
+            .arg("--observations")
+            .arg(example("ebrahimi2025_milling_observations.json")),
+    );
     assert!(err.contains("samples"), "{err}");
 }
 
@@ -422,29 +395,24 @@ fn diagnose_rejects_bad_input() {
 fn update_writes_posterior_summary_model_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("posterior");
-    let out = chatter()
-        .args([
-            "update",
-            "--quiet",
-            "--classes",
-            "0.5,1",
-            "--samples",
-            "200",
-            "--seed",
-            "3",
-            "--model",
-        ])
-        .arg(example("ahmadi2022_turning_model.json"))
-        .arg("--observations")
-        .arg(example("ahmadi2022_turning_observations.json"))
-        .arg("--out")
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    succeed(
+        chatter()
+            .args([
+                "update",
+                "--quiet",
+                "--classes",
+                "0.5,1",
+                "--samples",
+                "200",
+                "--seed",
+                "3",
+                "--model",
+            ])
+            .arg(example("ahmadi2022_turning_model.json"))
+            .arg("--observations")
+            .arg(example("ahmadi2022_turning_observations.json"))
+            .arg("--out")
+            .arg(&out_dir),
     );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
@@ -481,16 +449,7 @@ fn update_writes_posterior_summary_model_and_plots() {
     }
     // the updated model is a valid model file with the mode-2 frequency raised
     let updated = out_dir.join("updated_model.json");
-    let check = chatter()
-        .args(["check", "--model"])
-        .arg(&updated)
-        .output()
-        .unwrap();
-    assert!(
-        check.status.success(),
-        "{}",
-        String::from_utf8_lossy(&check.stderr)
-    );
+    succeed(chatter().args(["check", "--model"]).arg(&updated));
     let model: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&updated).unwrap()).unwrap();
     let f2 = model["modes"][1]["frequency_hz"].as_f64().unwrap();
@@ -502,33 +461,28 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     // identified milling poles with TMCMC (002)
     let out_dir = dir.path().join("tmcmc");
-    let out = chatter()
-        .args([
-            "update",
-            "--quiet",
-            "--sampler",
-            "tmcmc",
-            "--classes",
-            "0.01",
-            "--samples",
-            "40",
-            "--seed",
-            "1",
-            "--parameters",
-            "theta_omega_1,theta_zeta_1",
-            "--model",
-        ])
-        .arg(example("ebrahimi2025_milling_model.json"))
-        .arg("--observations")
-        .arg(example("ebrahimi2025_milling_observations.json"))
-        .arg("--out")
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    succeed(
+        chatter()
+            .args([
+                "update",
+                "--quiet",
+                "--sampler",
+                "tmcmc",
+                "--classes",
+                "0.01",
+                "--samples",
+                "40",
+                "--seed",
+                "1",
+                "--parameters",
+                "theta_omega_1,theta_zeta_1",
+                "--model",
+            ])
+            .arg(example("ebrahimi2025_milling_model.json"))
+            .arg("--observations")
+            .arg(example("ebrahimi2025_milling_observations.json"))
+            .arg("--out")
+            .arg(&out_dir),
     );
     let summary = std::fs::read_to_string(out_dir.join("summary.json")).unwrap();
     assert!(summary.contains("sigma_w2_hz2"), "{summary}");
@@ -540,31 +494,26 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
     )
     .unwrap();
     let out_dir = dir.path().join("amcmc");
-    let out = chatter()
-        .args([
-            "update",
-            "--quiet",
-            "--sampler",
-            "amcmc",
-            "--samples",
-            "60",
-            "--seed",
-            "1",
-            "--parameters",
-            "kn_n_per_mm2",
-            "--model",
-        ])
-        .arg(example("ebrahimi2025_milling_model.json"))
-        .arg("--observations")
-        .arg(&cuts)
-        .arg("--out")
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    succeed(
+        chatter()
+            .args([
+                "update",
+                "--quiet",
+                "--sampler",
+                "amcmc",
+                "--samples",
+                "60",
+                "--seed",
+                "1",
+                "--parameters",
+                "kn_n_per_mm2",
+                "--model",
+            ])
+            .arg(example("ebrahimi2025_milling_model.json"))
+            .arg("--observations")
+            .arg(&cuts)
+            .arg("--out")
+            .arg(&out_dir),
     );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
@@ -582,26 +531,24 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
         vec!["--priors".to_string(), priors.display().to_string()],
         vec!["--parameters".to_string(), "theta_bogus_1".to_string()],
     ] {
-        let out = chatter()
-            .args([
-                "update",
-                "--quiet",
-                "--samples",
-                "20",
-                "--seed",
-                "1",
-                "--model",
-            ])
-            .arg(example("ahmadi2022_turning_model.json"))
-            .arg("--observations")
-            .arg(example("ahmadi2022_turning_observations.json"))
-            .arg("--out")
-            .arg(dir.path().join("never"))
-            .args(&extra)
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(1), "{extra:?}");
-        let err = String::from_utf8(out.stderr).unwrap();
+        let err = fail(
+            chatter()
+                .args([
+                    "update",
+                    "--quiet",
+                    "--samples",
+                    "20",
+                    "--seed",
+                    "1",
+                    "--model",
+                ])
+                .arg(example("ahmadi2022_turning_model.json"))
+                .arg("--observations")
+                .arg(example("ahmadi2022_turning_observations.json"))
+                .arg("--out")
+                .arg(dir.path().join("never"))
+                .args(&extra),
+        );
         assert!(
             err.contains("abc") || err.contains("theta_k_7") || err.contains("theta_bogus_1"),
             "{err}"
@@ -613,50 +560,46 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
 #[test]
 fn plan_prints_the_next_cut() {
     for strategy in ["voi", "mrr"] {
-        let out = chatter()
-            .args([
-                "plan",
-                "--quiet",
-                "--paths",
-                "40",
-                "--strategy",
-                strategy,
-                "--model",
-            ])
-            .arg(example("ebrahimi2025_milling_model.json"))
-            .arg("--observations")
-            .arg(example("ebrahimi2025_milling_observations.json"))
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        let out = succeed(
+            chatter()
+                .args([
+                    "plan",
+                    "--quiet",
+                    "--paths",
+                    "40",
+                    "--strategy",
+                    strategy,
+                    "--model",
+                ])
+                .arg(example("ebrahimi2025_milling_model.json"))
+                .arg("--observations")
+                .arg(example("ebrahimi2025_milling_observations.json")),
         );
-        let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let plan: serde_json::Value = serde_json::from_str(&out).unwrap();
         assert_eq!(plan["strategy"], strategy);
         let speed = plan["next_cut"]["speed_rpm"].as_f64().unwrap();
         assert!((1575.0..=3000.0).contains(&speed), "{speed}");
         assert!(plan["next_cut"]["depth_mm"].as_f64().unwrap() > 0.0);
         assert!(plan["stop"].is_boolean());
     }
-    let out = chatter()
-        .args([
-            "plan",
-            "--quiet",
-            "--strategy",
-            "mrr",
-            "--p-test",
-            "1.5",
-            "--model",
-        ])
-        .arg(example("ebrahimi2025_milling_model.json"))
-        .arg("--observations")
-        .arg(example("ebrahimi2025_milling_observations.json"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8(out.stderr).unwrap().contains("p_test"));
+    assert!(
+        fail(
+            chatter()
+                .args([
+                    "plan",
+                    "--quiet",
+                    "--strategy",
+                    "mrr",
+                    "--p-test",
+                    "1.5",
+                    "--model",
+                ])
+                .arg(example("ebrahimi2025_milling_model.json"))
+                .arg("--observations")
+                .arg(example("ebrahimi2025_milling_observations.json"))
+        )
+        .contains("p_test")
+    );
 }
 
 /// `chatter oma` on a small signal file: a seeded 800 Hz mode (zeta 2 %) on two channels plus a
@@ -713,19 +656,14 @@ fn oma_identifies_the_signals_of_an_observations_file() {
              "once_per_rev_channel": "tach", "quantity": "acceleration" }"#,
     );
     let svg = dir.path().join("diagram.svg");
-    let out = chatter()
-        .args(["oma", "--observations"])
-        .arg(&obs)
-        .arg("--plot")
-        .arg(&svg)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = succeed(
+        chatter()
+            .args(["oma", "--observations"])
+            .arg(&obs)
+            .arg("--plot")
+            .arg(&svg),
     );
-    let result: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let result: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(result["cuts"].as_array().unwrap().len(), 1);
     let pole = &result["poles"][0];
     assert_eq!(pole["speed_rpm"], 7150.0);
@@ -738,7 +676,7 @@ fn oma_identifies_the_signals_of_an_observations_file() {
     assert!(pole["note"].as_str().unwrap().contains("modified LSCE"));
     // the output is itself a valid observations file
     let reread = dir.path().join("poles.json");
-    std::fs::write(&reread, &out.stdout).unwrap();
+    std::fs::write(&reread, &out).unwrap();
     chatter_dynamics::Observations::from_path(&reread).unwrap();
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
 
@@ -759,13 +697,7 @@ fn oma_identifies_the_signals_of_an_observations_file() {
         ),
     ] {
         let obs = write_obs(entry);
-        let out = chatter()
-            .args(["oma", "--observations"])
-            .arg(&obs)
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(1));
-        let err = String::from_utf8(out.stderr).unwrap();
+        let err = fail(chatter().args(["oma", "--observations"]).arg(&obs));
         assert!(
             err.contains("obs.json") && err.contains("signals[0]") && err.contains(expected),
             "{err}"
