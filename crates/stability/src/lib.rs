@@ -13,6 +13,7 @@ pub mod frequency_domain;
 pub mod monodromy;
 pub mod multiplier;
 pub mod process_damping;
+mod root;
 pub mod sensitivity;
 pub mod zero_order;
 
