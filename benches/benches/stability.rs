@@ -1,11 +1,14 @@
 //! Stability solver speed: the dominant multiplier of the single-DOF benchmark at m = 40, a
-//! 200-speed FDM lobe diagram at m = 40, and the seed-000 turning multiplier at the default
-//! resolution.
+//! 200-speed FDM lobe diagram at m = 40, the seed-000 turning multiplier at the default
+//! resolution, and the zero-order limiting depth at one speed (seed-001 two-mode milling, seed-000
+//! turning) and over a 200-speed lobe diagram.
 use chatter_dynamics::examples;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, Silent, lobe_diagram, speed_range};
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::zero_order::{zoa_limiting_depth, zoa_lobes};
 use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
     let benchmark = examples::insperger_benchmark(1.0);
@@ -38,5 +41,23 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+fn zero_order(c: &mut Criterion) {
+    let milling = examples::schmitz_2023_milling();
+    let turning = examples::ahmadi_2022_turning();
+    let mut group = c.benchmark_group("zero_order");
+    group.sample_size(10);
+    group.bench_function("zoa_limiting_depth_milling_2_modes", |b| {
+        b.iter(|| zoa_limiting_depth(&milling, black_box(6960.0)))
+    });
+    group.bench_function("zoa_limiting_depth_turning", |b| {
+        b.iter(|| zoa_limiting_depth(&turning, black_box(7150.0)))
+    });
+    let speeds = speed_range(4000.0, 16_000.0, 200).unwrap_or_default();
+    group.bench_function("zoa_lobes_200_speeds_milling_2_modes", |b| {
+        b.iter(|| zoa_lobes(&milling, black_box(&speeds)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, zero_order);
 criterion_main!(benches);

@@ -99,3 +99,36 @@ pub fn insperger_benchmark(radial_immersion: f64) -> ModalModel {
     };
     build().unwrap_or_else(|e| panic!("benchmark with a/D = {radial_immersion}: {e}"))
 }
+
+/// A flexure like the one of seed 003 (Karandikar, Tyler and Schmitz) for process damping: one
+/// 228 Hz mode in x (damping ratio 0.02, stiffness 5.6e6 N/m; the text does not give the
+/// flexure's stiffness and damping, so these are chosen here), a single-tooth 18.54 mm cutter in
+/// 50 % up milling, kt 2111.2 and kn 1052.6 N/mm^2, and the process-damping coefficient
+/// `c_n_per_m` (N/m) of F_d = -C b ydot / V.
+pub fn process_damping_flexure(c_n_per_m: Option<f64>) -> ModalModel {
+    let build = || -> crate::Result<ModalModel> {
+        let mode = Mode::new(
+            228.0,
+            0.02,
+            ModeShape::Directional {
+                coordinate: 0,
+                stiffness_n_per_m: 5.6e6,
+            },
+        )?;
+        let op = Operation::Milling(Milling::new(
+            1,
+            0.5,
+            MillingDirection::Up,
+            Some(18.54e-3),
+            None,
+        )?);
+        ModalModel::new(
+            Some("003-like flexure".into()),
+            op,
+            CuttingCoefficients::new(2111.2e6, 1052.6e6)?,
+            vec![mode],
+            c_n_per_m,
+        )
+    };
+    build().unwrap_or_else(|e| panic!("003-like flexure with C = {c_n_per_m:?}: {e}"))
+}

@@ -24,8 +24,6 @@ use chatter_dynamics::ModalModel;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// Grid density of the models inside the samplers.
-const INFERENCE_DENSITY: usize = 1;
 /// C_max: the process damping that adds this many times a mode's structural damping at the
 /// lowest observed speed and the lowest nominal limiting depth, for the mode it acts on most.
 const PROCESS_DAMPING_SPAN: f64 = 2.0;
@@ -105,8 +103,7 @@ impl Nominal {
     /// The nominal model with the geometries of `immersions`; `speeds` are the observed speeds
     /// (rpm) that scale the priors.
     pub fn new(model: &ModalModel, immersions: &[Option<f64>], speeds: &[f64]) -> Result<Self> {
-        let machine =
-            Machine::from_model(model, geometries(model, immersions)?, INFERENCE_DENSITY)?;
+        let machine = Machine::from_model(model, geometries(model, immersions)?)?;
         let a = machine.geometries[0].directional;
         let dominant = machine
             .modes

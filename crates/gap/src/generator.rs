@@ -40,9 +40,6 @@ use rand_distr::{Distribution, Normal};
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// Grid density of the true machine.
-const TRUTH_DENSITY: usize = 4;
-
 /// The effect hidden in the true machine.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -245,7 +242,7 @@ fn true_machine(nominal: &ModalModel, scenario: &Scenario) -> Result<Machine> {
         )?;
         model = model.with_operation(Operation::Milling(fewer))?;
     }
-    let mut m = Machine::from_model(&model, geometries(&model, &[None])?, TRUTH_DENSITY)?;
+    let mut m = Machine::from_model(&model, geometries(&model, &[None])?)?;
     let e = scenario.error;
     positive("error.frequency_factor", e.frequency_factor)?;
     positive("error.damping_factor", e.damping_factor)?;
@@ -314,7 +311,7 @@ enum Entry {
 /// Synthetic observations of `scenario` on the machine whose nominal model is `nominal`.
 pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observations> {
     let truth = true_machine(nominal, scenario)?;
-    let nominal_fast = Machine::from_model(nominal, geometries(nominal, &[None])?, TRUTH_DENSITY)?;
+    let nominal_fast = Machine::from_model(nominal, geometries(nominal, &[None])?)?;
     for &s in scenario.speeds_rpm.iter().chain(&scenario.pole_speeds_rpm) {
         positive("speeds_rpm", s)?;
     }

@@ -24,10 +24,10 @@
 //!
 //! # Model
 //! Inside the samplers every machine variant is evaluated in a fast zero-order form: the
-//! Altintas-Budak characteristic equation det(I + b (1 - e^{-i w tau}) A_0 G(i w)) = 0 tabulated
-//! once per variant on a resonance-concentrated frequency grid and solved only at the observed
-//! speeds, the process-damping fixed point b = b_lim(zeta(b)) of 003's iterative algorithm
-//! solved by Newton's method on each lobe, and the dominant closed-loop pole of the averaged
+//! Altintas-Budak characteristic equation det(I + b (1 - e^{-i w tau}) A_0 G(i w)) = 0 by the
+//! solver of `chatter-stability` (tabulated once per variant, solved exactly at the observed
+//! speeds, with the process-damping fixed point b = b_lim(zeta(b)) of 003's iterative algorithm
+//! as a branch of the lobes), and the dominant closed-loop pole of the averaged
 //! delay equation (000 Eq. 5-6; lifted once per tooth period for milling as in 002) by
 //! continuation in depth. The observation model ([`likelihood`]) is a probit in
 //! ln(b / b_lim) with label noise, a folded Gaussian for chatter frequencies and Gaussians for

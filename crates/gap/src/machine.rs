@@ -1,16 +1,12 @@
 //! A fast zero-order representation of a machine variant: the limiting depth and chatter
 //! frequency at given spindle speeds and the dominant closed-loop pole of a stable cut, cheap
-//! enough to sit inside the samplers (tens of microseconds per model).
+//! enough to sit inside the samplers.
 //!
 //! # Boundary
 //! The zero-order (Altintas-Budak) characteristic equation det(I + b (1 - e^{-i w tau}) A G(i w)) = 0,
 //! with A the averaged directional matrix (milling) or K_c (turning) and G the receptance, is
-//! solved as in `chatter_stability::zero_order`: with Lambda an eigenvalue of A G(i w),
-//! eps = (2 arg Lambda - pi) mod 4 pi in (0, 2 pi) and b = 1 / (2 sin(eps/2) |Lambda|) = -1 / (2 Re Lambda). Here the
-//! two eigenvalue branches are tabulated once per model on a frequency grid concentrated at the
-//! resonances (a sinh-spaced set of points per mode plus a coarse geometric grid), and at each
-//! requested speed the lobes k are the crossings of psi(w) = w tau / 2 pi - eps / 2 pi with the
-//! integers; the lowest crossing is the limiting depth and its frequency the chatter frequency.
+//! solved by [`chatter_stability::zero_order::LobeTable`]: the eigenvalue branches are tabulated
+//! once per model and geometry, and at each requested speed the lowest lobes are solved exactly.
 //!
 //! # Speed-dependent modes
 //! When every natural frequency falls with speed as w_n(Omega) = w_n (1 - c Omega^2) at constant
@@ -20,11 +16,11 @@
 //!
 //! # Process damping (seed 003)
 //! F_d = -C b ydot / V adds the modal damping b phi_n^T D phi_n (D the rotation-averaged C/V n n^T,
-//! as in `chatter_stability::process_damping`). The iterative algorithm of 003 converges to the
-//! fixed point b = b_lim(zeta(b)); here that fixed point is solved directly: starting from the
-//! lowest lobe crossings of the table computed with the damping at the bare limit, Newton's method
-//! on the real and imaginary parts of the characteristic function over (w, b) lands on the
-//! fixed point of each lobe, and the lowest is the limiting depth.
+//! [`chatter_stability::process_damping::average_normal_projector`]), i.e. the damping ratios
+//! zeta_n + b (C / V) s_n with s_n the slopes at unit C / V. The fixed point b = b_lim(zeta(b)) of
+//! 003's iterative algorithm is solved by a [`ProcessDampedTable`] per geometry, scaled by C / V at
+//! each speed. With softening the same rescaling holds with the scale multiplied by s (the
+//! damping ratio of the softened mode is zeta_n + s^2 b' (C / V) s_n / s at b = s^2 b').
 //!
 //! # Poles
 //! The dominant closed-loop pole of the averaged system is a root of the entire function
@@ -37,51 +33,30 @@
 
 use crate::error::{GapError, Result};
 use chatter_dynamics::{ModalModel, Operation};
+use chatter_stability::process_damping::{average_normal_projector, damping_ratio_slope_per_m};
+use chatter_stability::zero_order::{
+    LobeTable, ModalTerm, OrientedSystem, ProcessDampedTable, ZeroOrderOptions,
+};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
 /// A real 2 x 2 matrix, rows first.
 pub(crate) type Mat2 = [[f64; 2]; 2];
 
-/// Points per mode of the sinh-spaced resonance grid, and of the coarse geometric grid, at unit
-/// density.
-const MODE_POINTS: usize = 41;
-const GLOBAL_POINTS: usize = 24;
-/// Frequency range of the tables relative to the lowest and highest natural frequency.
-const GRID_LOW: f64 = 0.5;
-const GRID_HIGH: f64 = 2.0;
-/// Newton iterations and tolerances of the pole continuation and the process-damping solve.
+/// Newton iterations and tolerances of the pole continuation.
 const NEWTON_ITERATIONS: usize = 30;
 const POLE_TOLERANCE: f64 = 1e-10;
 const STEP_TOLERANCE: f64 = 1e-6;
 const LOOSE_TOLERANCE: f64 = 1e-7;
-const LOBE_TOLERANCE: f64 = 1e-8;
 /// A pole decaying at most this many times as fast as the dominant one may be identified
 /// instead of it.
 const NEAR_TIE_DECAY: f64 = 1.5;
 /// Continuation steps of the pole in depth.
 const POLE_STEPS: usize = 4;
-/// Added process damping below this fraction of the structural damping is ignored.
-const NEGLIGIBLE_DAMPING: f64 = 0.005;
-/// Lowest crossings used as starting points of the process-damping solve.
-const DAMPED_STARTS: usize = 2;
-/// Relative added damping per step of the continuation in C, and the most steps.
-const MILD_DAMPING: f64 = 1.0;
-/// Relative added damping below which the check for lower lobes is skipped.
-const UNCHECKED_DAMPING: f64 = 0.6;
-const MAX_DAMPING_STEPS: usize = 6;
-/// Rounds of the check for lower lobes, and its relative tolerance.
-const VERIFY_ROUNDS: usize = 4;
-const VERIFY_TOLERANCE: f64 = 1e-3;
-/// Interpolation error of the tables' crossings tolerated without a Newton confirmation.
-const TABLE_TOLERANCE: f64 = 0.05;
 /// Lobes above the lowest reported at each speed (candidate chatter frequencies).
 const NEXT_LOBES: usize = 2;
-/// The plain 003 iteration (fallback): iterations and relative tolerance.
-const FIXED_POINT_ITERATIONS: usize = 20;
-const FIXED_POINT_TOLERANCE: f64 = 1e-4;
-/// Segments moved to the front of a table's search order.
-const EARLY_SEGMENTS: usize = 16;
+/// Lobes reported with process damping (the lowest and the next: each costs fixed points).
+const DAMPED_LOBES: usize = 2;
 /// Floor of the speed-softening factor s = 1 - c Omega^2.
 const MIN_SOFTENING: f64 = 0.05;
 
@@ -194,159 +169,10 @@ pub(crate) struct Machine {
     pub drift_rate: f64,
     /// Pole convention.
     pub convention: PoleConvention,
-    /// Grid density multiplier (1 for inference, more for synthetic truth).
-    pub density: usize,
-}
-
-/// The two eigenvalue branches tabulated on a frequency grid, with the grid segments of both
-/// branches and their lower depth, the lowest few first, so a crossing search skips most.
-struct Table {
-    f_hz: Vec<f64>,
-    eps: [Vec<f64>; 2],
-    depth: [Vec<f64>; 2],
-    /// (lower depth of the segment, first point, branch).
-    segments: Vec<(f64, u32, u8)>,
-}
-
-/// Receptance matrix entries (g00, g01, g11) at s (i w for FRFs).
-fn receptance(modes: &[FastMode], s: Complex64) -> [Complex64; 3] {
-    let mut g = [Complex64::new(0.0, 0.0); 3];
-    for m in modes {
-        let d = s * s + 2.0 * m.zeta * m.omega * s + m.omega * m.omega;
-        let inv = d.inv();
-        g[0] += m.phi[0] * m.phi[0] * inv;
-        g[1] += m.phi[0] * m.phi[1] * inv;
-        g[2] += m.phi[1] * m.phi[1] * inv;
-    }
-    g
-}
-
-/// Eigenvalues of A G.
-fn eigen_ag(a: &Mat2, g: [Complex64; 3]) -> [Complex64; 2] {
-    let m00 = a[0][0] * g[0] + a[0][1] * g[1];
-    let m01 = a[0][0] * g[1] + a[0][1] * g[2];
-    let m10 = a[1][0] * g[0] + a[1][1] * g[1];
-    let m11 = a[1][0] * g[1] + a[1][1] * g[2];
-    let tr = m00 + m11;
-    let det = m00 * m11 - m01 * m10;
-    let disc = (tr * tr * 0.25 - det).sqrt();
-    [tr * 0.5 + disc, tr * 0.5 - disc]
 }
 
 fn scaled(a: &Mat2, k: f64) -> Mat2 {
     [[a[0][0] * k, a[0][1] * k], [a[1][0] * k, a[1][1] * k]]
-}
-
-/// The frequency grid (Hz) of the tables: sinh-spaced around every mode plus a coarse geometric
-/// grid over [0.5 f_min, 2 f_max].
-fn frequency_grid(modes: &[FastMode], density: usize) -> Vec<f64> {
-    let hz = |m: &FastMode| m.omega / (2.0 * PI);
-    let f_min = modes.iter().map(hz).fold(f64::INFINITY, f64::min);
-    let f_max = modes.iter().map(hz).fold(0.0, f64::max);
-    let (lo, hi) = (GRID_LOW * f_min, GRID_HIGH * f_max);
-    let density = density.max(1);
-    let global = GLOBAL_POINTS * density;
-    let local = MODE_POINTS * density;
-    let mut f: Vec<f64> = (0..global)
-        .map(|i| lo * (hi / lo).powf(i as f64 / (global - 1) as f64))
-        .collect();
-    for m in modes {
-        let fn_hz = hz(m);
-        let zeta = m.zeta.max(1e-4);
-        for i in 0..local {
-            let u = -2.5 + 6.0 * i as f64 / (local - 1) as f64;
-            let v = fn_hz * (1.0 + 2.0 * zeta * u.sinh());
-            if v > lo && v < hi {
-                f.push(v);
-            }
-        }
-    }
-    f.sort_by(f64::total_cmp);
-    f.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * *b);
-    f
-}
-
-fn table(modes: &[FastMode], a: &Mat2, f_hz: Vec<f64>) -> Table {
-    let n = f_hz.len();
-    let mut eps = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    let mut depth = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    let mut previous: Option<[Complex64; 2]> = None;
-    for &f in &f_hz {
-        let g = receptance(modes, Complex64::new(0.0, 2.0 * PI * f));
-        let mut lam = eigen_ag(a, g);
-        if let Some(p) = previous {
-            let straight = (lam[0] - p[0]).norm_sqr() + (lam[1] - p[1]).norm_sqr();
-            let swapped = (lam[1] - p[0]).norm_sqr() + (lam[0] - p[1]).norm_sqr();
-            if swapped < straight {
-                lam.swap(0, 1);
-            }
-        }
-        previous = Some(lam);
-        for (k, l) in lam.iter().enumerate() {
-            // Re(Lambda) < 0 is eps in (0, 2 pi); then b = 1 / (2 sin(eps/2) |Lambda|) = -1 / (2 Re(Lambda))
-            if l.re < 0.0 {
-                eps[k].push((2.0 * l.arg() - PI).rem_euclid(4.0 * PI));
-                depth[k].push(-0.5 / l.re);
-            } else {
-                eps[k].push(f64::NAN);
-                depth[k].push(f64::NAN);
-            }
-        }
-    }
-    let mut segments = Vec::with_capacity(2 * n);
-    for k in 0..2 {
-        for j in 0..n.saturating_sub(1) {
-            let (b0, b1) = (depth[k][j], depth[k][j + 1]);
-            if b0.is_finite() && b1.is_finite() && (eps[k][j + 1] - eps[k][j]).abs() <= PI {
-                segments.push((b0.min(b1), j as u32, k as u8));
-            }
-        }
-    }
-    // the lowest segments first, so the search below finds a tight bound early
-    if segments.len() > EARLY_SEGMENTS {
-        segments.select_nth_unstable_by(EARLY_SEGMENTS, |x, y| x.0.total_cmp(&y.0));
-    }
-    Table {
-        f_hz,
-        eps,
-        depth,
-        segments,
-    }
-}
-
-impl Table {
-    /// The `n` lowest lobe crossings at delay `tau` (s), lowest first, as (depth m, Hz).
-    fn lowest_crossings(&self, tau: f64, n: usize) -> Vec<(f64, f64)> {
-        let mut best: Vec<(f64, f64)> = Vec::with_capacity(n + 1);
-        for &(lower, j, k) in &self.segments {
-            if best.len() == n && best.last().is_some_and(|l| l.0 <= lower) {
-                continue;
-            }
-            let (j, k) = (j as usize, k as usize);
-            let (b0, b1) = (self.depth[k][j], self.depth[k][j + 1]);
-            let (f0, f1) = (self.f_hz[j], self.f_hz[j + 1]);
-            let p0 = f0 * tau - self.eps[k][j] / (2.0 * PI);
-            let p1 = f1 * tau - self.eps[k][j + 1] / (2.0 * PI);
-            if p0 == p1 {
-                continue;
-            }
-            let (lo, hi) = if p0 < p1 { (p0, p1) } else { (p1, p0) };
-            let first = lo.ceil().max(0.0) as i64;
-            let last = hi.floor() as i64;
-            for lobe in first..=last {
-                let t = (lobe as f64 - p0) / (p1 - p0);
-                // -2 Re(Lambda) = 1 / b is smooth in frequency; b itself is not near lobe sides
-                let b = 1.0 / (1.0 / b0 + t * (1.0 / b1 - 1.0 / b0));
-                if best.len() == n && best.last().is_some_and(|l| l.0 <= b) {
-                    continue;
-                }
-                let at = best.partition_point(|x| x.0 <= b);
-                best.insert(at, (b, f0 + t * (f1 - f0)));
-                best.truncate(n);
-            }
-        }
-        best
-    }
 }
 
 /// The characteristic function F(s) (entire; see the module docs) of modes with depth `b`,
@@ -488,33 +314,17 @@ pub(crate) fn geometries(model: &ModalModel, immersions: &[Option<f64>]) -> Resu
                 _ => model.clone(),
             };
             let h = m.average_directional_matrix();
-            let damping_per_cv = match m.operation() {
-                Operation::Turning(_) => [[1.0, 0.0], [0.0, 0.0]],
-                Operation::Milling(op) => {
-                    let (a, b) = op.entry_exit_rad();
-                    let f = op.teeth() as f64 / (2.0 * PI);
-                    let ss = |p: f64| 0.5 * p - 0.25 * (2.0 * p).sin();
-                    let cc = |p: f64| 0.5 * p + 0.25 * (2.0 * p).sin();
-                    let sc = |p: f64| 0.5 * p.sin().powi(2);
-                    let (iss, icc, isc) = (ss(b) - ss(a), cc(b) - cc(a), sc(b) - sc(a));
-                    [[f * iss, f * isc], [f * isc, f * icc]]
-                }
-            };
             Ok(Geometry {
                 directional: [[h[(0, 0)], h[(0, 1)]], [h[(1, 0)], h[(1, 1)]]],
-                damping_per_cv,
+                damping_per_cv: average_normal_projector(m.operation()),
             })
         })
         .collect()
 }
 
 impl Machine {
-    /// The fast form of `model` with the given cut geometries and grid density.
-    pub fn from_model(
-        model: &ModalModel,
-        geometries: Vec<Geometry>,
-        density: usize,
-    ) -> Result<Self> {
+    /// The fast form of `model` with the given cut geometries.
+    pub fn from_model(model: &ModalModel, geometries: Vec<Geometry>) -> Result<Self> {
         let modes = model
             .modes()
             .iter()
@@ -540,7 +350,6 @@ impl Machine {
                 Operation::Milling(_) => PoleConvention::Lifted,
                 Operation::Turning(_) => PoleConvention::Physical,
             },
-            density,
         })
     }
 
@@ -579,7 +388,9 @@ impl Machine {
             .map(|m| {
                 let omega = m.omega * s;
                 let added = match d {
-                    Some(d) if cv > 0.0 => depth_m * cv * quadratic(&d, m.phi) / (2.0 * omega),
+                    Some(d) if cv > 0.0 => {
+                        depth_m * damping_ratio_slope_per_m(m.phi, omega, &scaled(&d, cv))
+                    }
                     _ => 0.0,
                 };
                 FastMode {
@@ -601,226 +412,70 @@ impl Machine {
         }
     }
 
-    /// Limiting depth and chatter frequency at each (speed, geometry) request, at campaign
-    /// position 0 (drift scales the depth by 1 / (1 + r u) afterwards).
+    /// Limiting depth and chatter frequency at each (speed, geometry) request, with the next
+    /// lobes above it, at campaign position 0 (drift scales the depth by 1 / (1 + r u)
+    /// afterwards). Requests of an unknown geometry, or of modes that make no valid zero-order
+    /// system (non-finite values from a sampler), are unbounded.
     pub fn boundary(&self, requests: &[(f64, usize)]) -> Vec<BoundaryPoint> {
-        let grid = frequency_grid(&self.modes, self.density);
-        let tables: Vec<Table> = self
+        let modes: Vec<ModalTerm> = self
+            .modes
+            .iter()
+            .map(|m| ModalTerm {
+                omega_rad_s: m.omega,
+                damping_ratio: m.zeta,
+                shape: m.phi,
+            })
+            .collect();
+        let tables: Vec<Option<LobeTable>> = self
             .geometries
             .iter()
             .map(|g| {
-                table(
-                    &self.modes,
-                    &scaled(&g.directional, self.gain),
-                    grid.clone(),
-                )
+                OrientedSystem::new(modes.clone(), scaled(&g.directional, self.gain))
+                    .ok()
+                    .map(LobeTable::new)
             })
             .collect();
-        let wanted = if self.process_damping_n_per_m > 0.0 {
-            DAMPED_STARTS
-        } else {
-            1 + NEXT_LOBES
-        };
+        // the slopes of the damping ratios at unit C / V; none without process damping
+        let damped: Vec<Option<ProcessDampedTable>> = self
+            .geometries
+            .iter()
+            .zip(&tables)
+            .map(|(g, table)| {
+                let table = table.as_ref()?;
+                let slopes: Vec<f64> = self
+                    .modes
+                    .iter()
+                    .map(|m| damping_ratio_slope_per_m(m.phi, m.omega, &g.damping_per_cv))
+                    .collect();
+                (self.process_damping_per_velocity(1.0) > 0.0)
+                    .then(|| {
+                        ProcessDampedTable::new(table, &slopes, &ZeroOrderOptions::unbounded())
+                    })
+                    .and_then(|d| d.ok())
+            })
+            .collect();
         requests
             .iter()
             .map(|&(speed, geometry)| {
-                let Some(tab) = tables.get(geometry) else {
-                    return BoundaryPoint::UNBOUNDED;
-                };
                 let s = self.softening(speed);
-                let crossings: Vec<(f64, f64)> = tab
-                    .lowest_crossings(self.delay_s(speed / s), wanted)
-                    .into_iter()
-                    .map(|(b, f)| (s * s * b, s * f))
-                    .collect();
-                self.with_process_damping(crossings, speed, geometry, &grid)
-            })
-            .collect()
-    }
-
-    /// The lobes at one speed from the lowest bare lobe crossings, with the process-damping
-    /// fixed point of each where process damping matters.
-    fn with_process_damping(
-        &self,
-        crossings: Vec<(f64, f64)>,
-        speed_rpm: f64,
-        geometry: usize,
-        grid: &[f64],
-    ) -> BoundaryPoint {
-        let cv = self.process_damping_per_velocity(speed_rpm);
-        let (Some(geo), Some(&(b0, _))) = (self.geometries.get(geometry), crossings.first()) else {
-            return BoundaryPoint::from_crossings(&crossings);
-        };
-        let relative = self
-            .modes_with(speed_rpm, b0, geometry, cv)
-            .iter()
-            .zip(&self.modes)
-            .map(|(d, m)| d.zeta / m.zeta.max(1e-9) - 1.0)
-            .fold(0.0, f64::max);
-        if cv == 0.0 || relative < NEGLIGIBLE_DAMPING {
-            return BoundaryPoint::from_crossings(&crossings);
-        }
-        let a = scaled(&geo.directional, self.gain);
-        // continuation in C from each bare lobe: Newton on (f, b) at C j / J
-        let steps = ((relative / MILD_DAMPING).ceil() as usize).clamp(1, MAX_DAMPING_STEPS);
-        let mut lobes: Vec<(f64, f64)> = crossings
-            .iter()
-            .filter_map(|&(b, f)| {
-                (1..=steps).try_fold((b, f), |(b, f), j| {
-                    let c = cv * j as f64 / steps as f64;
-                    self.damped_lobe_newton(speed_rpm, geometry, &a, c, b, f)
+                let tau = self.delay_s(speed / s);
+                let lobes = match (tables.get(geometry), damped.get(geometry)) {
+                    (_, Some(Some(d))) => {
+                        let scale = s * self.process_damping_per_velocity(speed);
+                        d.lobes(tau, scale, DAMPED_LOBES)
+                    }
+                    (Some(Some(t)), _) => t.lobes(tau, 1 + NEXT_LOBES),
+                    _ => return BoundaryPoint::UNBOUNDED,
+                };
+                lobes.map_or(BoundaryPoint::UNBOUNDED, |l| {
+                    let scaled: Vec<(f64, f64)> = l
+                        .iter()
+                        .map(|l| (s * s * l.depth_m, s * l.chatter_hz))
+                        .collect();
+                    BoundaryPoint::from_crossings(&scaled)
                 })
             })
-            .collect();
-        // A lobe whose fixed point lies below the lowest found would cross below it in the
-        // table damped at that depth (the map b -> b_lim(zeta(b)) is a contraction): check, and
-        // start Newton from such crossings until none is left.
-        let tau = self.delay_s(speed_rpm);
-        if relative < UNCHECKED_DAMPING && !lobes.is_empty() {
-            lobes.sort_by(|x, y| x.0.total_cmp(&y.0));
-            return BoundaryPoint::from_crossings(&lobes);
-        }
-        for _ in 0..VERIFY_ROUNDS {
-            let Some(lowest) = lobes.iter().map(|l| l.0).min_by(f64::total_cmp) else {
-                break;
-            };
-            let modes = self.modes_with(speed_rpm, lowest, geometry, cv);
-            if modes.iter().any(|m| m.zeta >= 1.0) {
-                break;
-            }
-            let below: Vec<(f64, f64)> = table(&modes, &a, grid.to_vec())
-                .lowest_crossings(tau, DAMPED_STARTS)
-                .into_iter()
-                .filter(|c| c.0 < lowest * (1.0 - VERIFY_TOLERANCE))
-                .collect();
-            // Newton from a crossing below may land on a known lobe: the crossing was the
-            // table's interpolation error
-            let solved: Vec<Option<(f64, f64)>> = below
-                .iter()
-                .map(|&(b, f)| self.damped_lobe_newton(speed_rpm, geometry, &a, cv, b, f))
-                .collect();
-            let lower: Vec<(f64, f64)> = solved
-                .iter()
-                .flatten()
-                .copied()
-                .filter(|l| l.0 < lowest * (1.0 - VERIFY_TOLERANCE))
-                .collect();
-            let unresolved = below
-                .iter()
-                .zip(&solved)
-                .any(|(c, l)| l.is_none() && c.0 < lowest * (1.0 - TABLE_TOLERANCE));
-            if lower.is_empty() && !unresolved {
-                lobes.sort_by(|x, y| x.0.total_cmp(&y.0));
-                lobes.dedup_by(|x, y| (x.0 - y.0).abs() <= VERIFY_TOLERANCE * y.0);
-                return BoundaryPoint::from_crossings(&lobes);
-            }
-            if lower.is_empty() {
-                break;
-            }
-            lobes.extend(lower);
-        }
-        let mut lobes = self.damped_by_iteration(speed_rpm, geometry, &a, b0, grid);
-        lobes.sort_by(|x, y| x.0.total_cmp(&y.0));
-        BoundaryPoint::from_crossings(&lobes)
-    }
-
-    /// The process-damping fixed point by the plain iteration of 003 on the tables (the fallback
-    /// where no lobe continuation converges).
-    fn damped_by_iteration(
-        &self,
-        speed_rpm: f64,
-        geometry: usize,
-        a: &Mat2,
-        b0: f64,
-        grid: &[f64],
-    ) -> Vec<(f64, f64)> {
-        let tau = self.delay_s(speed_rpm);
-        let step = |x: f64| -> Vec<(f64, f64)> {
-            let modes = self.modes_at(speed_rpm, x, geometry);
-            if modes.iter().any(|m| m.zeta >= 1.0) {
-                return Vec::new();
-            }
-            table(&modes, a, grid.to_vec()).lowest_crossings(tau, 1 + NEXT_LOBES)
-        };
-        let mut history = vec![b0];
-        let mut lobes = Vec::new();
-        for _ in 0..FIXED_POINT_ITERATIONS {
-            let Some(&x) = history.last() else {
-                break;
-            };
-            lobes = step(x);
-            let Some(&(next, _)) = lobes.first() else {
-                return Vec::new();
-            };
-            if (next - x).abs() <= FIXED_POINT_TOLERANCE * next {
-                break;
-            }
-            history.push(next);
-            // Aitken's extrapolation every third step (kept above the last iterate)
-            if let [.., x0, x1, x2] = history[..]
-                && history.len() % 3 == 0
-            {
-                let denominator = x2 - 2.0 * x1 + x0;
-                if denominator < 0.0 {
-                    let extrapolated = x0 - (x1 - x0).powi(2) / denominator;
-                    history.push(extrapolated.clamp(x2, x2 + 3.0 * (x2 - x1).abs()));
-                }
-            }
-        }
-        lobes
-    }
-
-    /// Newton on (f, b) for F(i w; modes damped at b with C / V = `cv`) = 0 from a lobe point.
-    fn damped_lobe_newton(
-        &self,
-        speed_rpm: f64,
-        geometry: usize,
-        a: &Mat2,
-        cv: f64,
-        mut b: f64,
-        mut f: f64,
-    ) -> Option<(f64, f64)> {
-        let tau = self.delay_s(speed_rpm);
-        let base = self.modes_with(speed_rpm, 0.0, geometry, 0.0);
-        let d = self.geometries.get(geometry)?.damping_per_cv;
-        let rate: Vec<f64> = base
-            .iter()
-            .map(|m| cv * quadratic(&d, m.phi) / (2.0 * m.omega))
-            .collect();
-        let mut modes = base.clone();
-        // F(i 2 pi f) and dF/df at depth b
-        let mut eval = |f: f64, b: f64| -> Option<(Complex64, Complex64)> {
-            for ((m, m0), r) in modes.iter_mut().zip(&base).zip(&rate) {
-                m.zeta = m0.zeta + b * r;
-                if m.zeta >= 1.0 {
-                    return None;
-                }
-            }
-            let (v, dv) = characteristic(&modes, a, b, tau, Complex64::new(0.0, 2.0 * PI * f));
-            Some((v, dv * Complex64::new(0.0, 2.0 * PI)))
-        };
-        let (f_start, b_start) = (f, b);
-        for _ in 0..NEWTON_ITERATIONS {
-            let (r, rf) = eval(f, b)?;
-            let hb = 1e-7 * b;
-            let rb = (eval(f, b + hb)?.0 - r) / hb;
-            // solve [rf.re rb.re; rf.im rb.im] [df db]^T = -[r.re r.im]^T
-            let det = rf.re * rb.im - rb.re * rf.im;
-            if det == 0.0 || !det.is_finite() {
-                return None;
-            }
-            let df = -(r.re * rb.im - rb.re * r.im) / det;
-            let db = -(rf.re * r.im - r.re * rf.im) / det;
-            f += df;
-            b += db;
-            if !(f > 0.0 && b > 0.0) || (f / f_start - 1.0).abs() > 0.1 || b > 4.0 * b_start {
-                return None;
-            }
-            if df.abs() <= LOBE_TOLERANCE * f && db.abs() <= LOBE_TOLERANCE * b {
-                return Some((b, f));
-            }
-        }
-        None
+            .collect()
     }
 
     /// The dominant closed-loop pole (rad/s) at a speed, depth, geometry and campaign position:
@@ -933,7 +588,7 @@ mod tests {
     use chatter_stability::zero_order::zoa_lobes;
 
     fn fast(model: &ModalModel) -> Machine {
-        Machine::from_model(model, geometries(model, &[None]).unwrap(), 1).unwrap()
+        Machine::from_model(model, geometries(model, &[None]).unwrap()).unwrap()
     }
 
     fn milling_with_diameter() -> ModalModel {

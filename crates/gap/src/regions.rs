@@ -595,7 +595,7 @@ mod tests {
         let obs = synthesize(&model, &scenario).unwrap();
         let noise = NoiseModel::default();
         let data = Dataset::new(&model, &obs, &noise, 750.0).unwrap();
-        let machine = Machine::from_model(&model, geometries(&model, &[None]).unwrap(), 4).unwrap();
+        let machine = Machine::from_model(&model, geometries(&model, &[None]).unwrap()).unwrap();
         let r = residuals(&crate::likelihood::predict(&machine, &data), &data, &noise);
         // (the cuts at exactly the nominal limit may go either way)
         assert!(

@@ -8,9 +8,13 @@
 //! f_mu + k / tau closest to the mode that dominates the cut.
 
 use crate::StabilitySolver;
-use crate::error::{Result, StabilityError};
+use crate::error::{Result, StabilityError, invalid};
+use crate::root::{Bracket, illinois};
 use chatter_dynamics::ModalModel;
 use rayon::prelude::*;
+
+/// Most Illinois steps refining a bracketed limiting depth.
+const MAX_REFINEMENT_STEPS: usize = 200;
 
 /// Options of the boundary search.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,21 +43,14 @@ impl Default for BoundaryOptions {
 
 impl BoundaryOptions {
     fn validate(&self) -> Result<()> {
-        let bad = |field, value, expected| {
-            Err(StabilityError::InvalidInput {
-                field,
-                value,
-                expected,
-            })
-        };
         if !(self.start_depth_m > 0.0 && self.start_depth_m < self.max_depth_m) {
-            return bad("start_depth_m", self.start_depth_m, "0 < start < max depth");
+            return invalid("start_depth_m", self.start_depth_m, "0 < start < max depth");
         }
         if !(self.growth > 1.0 && self.growth.is_finite()) {
-            return bad("growth", self.growth, "a factor > 1");
+            return invalid("growth", self.growth, "a factor > 1");
         }
         if !(self.relative_tolerance > 0.0 && self.relative_tolerance < 0.1) {
-            return bad("relative_tolerance", self.relative_tolerance, "in (0, 0.1)");
+            return invalid("relative_tolerance", self.relative_tolerance, "in (0, 0.1)");
         }
         Ok(())
     }
@@ -146,34 +143,13 @@ pub fn limiting_depth<S: StabilitySolver + ?Sized>(
         }
         g_hi = f(hi)?;
     }
-    // Illinois regula falsi on the bracket [lo, hi]
-    let mut side = 0i8;
-    for _ in 0..200 {
-        if hi - lo <= options.relative_tolerance * hi {
-            break;
-        }
-        let mut b = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-        if !(b > lo && b < hi) {
-            b = 0.5 * (lo + hi);
-        }
-        let g = f(b)?;
-        if g < 0.0 {
-            lo = b;
-            g_lo = g;
-            if side == -1 {
-                g_hi *= 0.5;
-            }
-            side = -1;
-        } else {
-            hi = b;
-            g_hi = g;
-            if side == 1 {
-                g_lo *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    let depth_m = 0.5 * (lo + hi);
+    let bracket = illinois(
+        Bracket::new((lo, g_lo), (hi, g_hi)),
+        options.relative_tolerance,
+        MAX_REFINEMENT_STEPS,
+        f,
+    )?;
+    let depth_m = bracket.midpoint();
     let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
     Ok(LobePoint {
         speed_rpm,

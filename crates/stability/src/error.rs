@@ -37,6 +37,15 @@ pub enum StabilityError {
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, StabilityError>;
 
+/// The [`StabilityError::InvalidInput`] of `field` at `value`, expected `expected`.
+pub(crate) fn invalid<T>(field: &'static str, value: f64, expected: &'static str) -> Result<T> {
+    Err(StabilityError::InvalidInput {
+        field,
+        value,
+        expected,
+    })
+}
+
 /// Check a spindle speed (rpm) and depth (m) and return them.
 pub fn check_condition(speed_rpm: f64, depth_m: f64) -> Result<(f64, f64)> {
     if !(speed_rpm.is_finite() && speed_rpm > 0.0) {

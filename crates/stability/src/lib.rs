@@ -14,6 +14,7 @@ mod hessenberg;
 pub mod monodromy;
 pub mod multiplier;
 pub mod process_damping;
+mod root;
 pub mod sensitivity;
 pub mod zero_order;
 

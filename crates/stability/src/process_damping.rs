@@ -11,7 +11,9 @@
 //! for a single mode or a mode aligned with the surface normal the projection is exact.
 //!
 //! The discretized solvers ([`crate::monodromy`]) carry the same term exactly as -b D(t) xdot,
-//! so both routes agree where the zero-order method holds (checked in the tests).
+//! so both routes agree where the zero-order method holds (checked in the tests). The fast
+//! zero-order solver ([`crate::zero_order::limiting_depths`]) reaches the limit of this iteration
+//! directly; the iteration stays here as 003 states it, as the reference.
 
 use crate::boundary::LobePoint;
 use crate::error::{Result, StabilityError};
@@ -23,14 +25,17 @@ const MAX_ITERATIONS: usize = 200;
 /// Relative convergence of the limiting depth.
 const TOLERANCE: f64 = 1e-6;
 
-/// Rotation-averaged process-damping matrix per unit width (N s/m^3) over the two coordinates.
-fn average_process_damping(model: &ModalModel, speed_rpm: f64) -> [[f64; 2]; 2] {
-    let cv = model.process_damping_per_width(speed_rpm);
-    match model.operation() {
-        Operation::Turning(_) => [[cv, 0.0], [0.0, 0.0]],
+/// The surface-normal projector n n^T averaged over one delay (dimensionless): the feed
+/// coordinate for turning, (N / 2 pi) times the integral of n n^T over the cut for milling with
+/// n = (sin(phi), cos(phi)) the chip-thickness direction (003 Eq. 1 with
+/// [`ModalModel::process_damping_matrix`]). Times C / V it is the averaged process-damping matrix
+/// per unit width.
+pub fn average_normal_projector(operation: &Operation) -> [[f64; 2]; 2] {
+    match operation {
+        Operation::Turning(_) => [[1.0, 0.0], [0.0, 0.0]],
         Operation::Milling(m) => {
             let (a, b) = m.entry_exit_rad();
-            let f = m.teeth() as f64 / (2.0 * std::f64::consts::PI) * cv;
+            let f = m.teeth() as f64 / (2.0 * std::f64::consts::PI);
             let ss = |p: f64| 0.5 * p - 0.25 * (2.0 * p).sin();
             let cc = |p: f64| 0.5 * p + 0.25 * (2.0 * p).sin();
             let sc = |p: f64| 0.5 * p.sin().powi(2);
@@ -40,6 +45,41 @@ fn average_process_damping(model: &ModalModel, speed_rpm: f64) -> [[f64; 2]; 2] 
     }
 }
 
+/// d zeta_n / d b (1/m) of a mode with mass-normalized `shape` and natural frequency
+/// `omega_rad_s` under the averaged process-damping matrix `damping` per unit width
+/// (N s/m^3): the modal damping phi^T D phi adds to 2 zeta_n omega_n per unit width.
+pub fn damping_ratio_slope_per_m(
+    shape: [f64; 2],
+    omega_rad_s: f64,
+    damping: &[[f64; 2]; 2],
+) -> f64 {
+    let [p, q] = shape;
+    let quadratic =
+        p * (damping[0][0] * p + damping[0][1] * q) + q * (damping[1][0] * p + damping[1][1] * q);
+    quadratic / (2.0 * omega_rad_s)
+}
+
+/// d zeta_n / d b (1/m) of every mode of `model` at `speed_rpm`: the equivalent damping ratio
+/// at width b is zeta_n + b s_n (all zero without process damping).
+pub fn damping_ratio_slopes_per_m(model: &ModalModel, speed_rpm: f64) -> Vec<f64> {
+    let cv = model.process_damping_per_width(speed_rpm);
+    damping_ratio_slopes_per_cv(model)
+        .into_iter()
+        .map(|s| cv * s)
+        .collect()
+}
+
+/// [`damping_ratio_slopes_per_m`] per unit C / V ([`ModalModel::process_damping_per_width`]),
+/// whatever the model's C: the slopes at a speed are these times C / V there.
+pub fn damping_ratio_slopes_per_cv(model: &ModalModel) -> Vec<f64> {
+    let d = average_normal_projector(model.operation());
+    model
+        .modes()
+        .iter()
+        .map(|m| damping_ratio_slope_per_m(m.mass_normalized_shape(), m.omega_rad_s(), &d))
+        .collect()
+}
+
 /// The model with the process damping of width `depth_m` at `speed_rpm` folded into the modal
 /// damping ratios (and the explicit process-damping term removed).
 pub fn with_equivalent_damping(
@@ -47,16 +87,12 @@ pub fn with_equivalent_damping(
     speed_rpm: f64,
     depth_m: f64,
 ) -> Result<ModalModel> {
-    let d = average_process_damping(model, speed_rpm);
     let modes = model
         .modes()
         .iter()
-        .map(|m| {
-            let phi = m.mass_normalized_shape();
-            let c = depth_m
-                * (phi[0] * (d[0][0] * phi[0] + d[0][1] * phi[1])
-                    + phi[1] * (d[1][0] * phi[0] + d[1][1] * phi[1]));
-            let zeta = m.damping_ratio() + c / (2.0 * m.omega_rad_s());
+        .zip(damping_ratio_slopes_per_m(model, speed_rpm))
+        .map(|(m, slope)| {
+            let zeta = m.damping_ratio() + depth_m * slope;
             if zeta >= 1.0 {
                 return Err(StabilityError::Unsupported {
                     method: "process damping",

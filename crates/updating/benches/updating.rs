@@ -1,9 +1,12 @@
 //! Sampler benches on the seeds' cases: 5000 iTMCMC samples of the 000 turning case (one model
 //! class, the exact characteristic-equation likelihood; target < 5 s on 2 cores) and TMCMC on the
 //! 002 milling case with the exact monodromy likelihood (fewer samples; the time scales linearly).
+//! Also the zero-order limiting depth at one speed that the ensembles call thousands of times,
+//! without and with process damping (seed-001 milling with a 19.05 mm cutter, C = 1e5 N/m).
 
-use chatter_dynamics::examples;
+use chatter_dynamics::{Milling, MillingDirection, Operation, examples};
 use chatter_stability::monodromy::Discretization;
+use chatter_updating::boundary::{BoundaryOptions, limiting_depth};
 use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
 use chatter_updating::milling::MillingPoleLikelihood;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
@@ -77,5 +80,23 @@ fn ebrahimi_2025(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ahmadi_2022, ebrahimi_2025);
+fn boundary(c: &mut Criterion) {
+    let bare = examples::schmitz_2023_milling();
+    let cutter = Milling::new(4, 0.2, MillingDirection::Down, Some(0.01905), None)
+        .and_then(|op| bare.with_operation(Operation::Milling(op)))
+        .and_then(|m| m.with_process_damping(Some(1e5)))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let options = BoundaryOptions::default();
+    let mut group = c.benchmark_group("boundary");
+    group.sample_size(20);
+    group.bench_function("limiting_depth_milling_2_modes", |b| {
+        b.iter(|| limiting_depth(&bare, black_box(6960.0), &options))
+    });
+    group.bench_function("limiting_depth_process_damping", |b| {
+        b.iter(|| limiting_depth(&cutter, black_box(3000.0), &options))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, ahmadi_2022, ebrahimi_2025, boundary);
 criterion_main!(benches);

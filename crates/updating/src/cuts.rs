@@ -14,7 +14,7 @@
 //! (seed 003, Eq. 3 for a stable and Eq. 4 for an unstable result): l = 1 on the side of the path
 //! that agrees with the result and exp(-(b - b_test)^2 / k), k = 2 sigma^2, on the other.
 
-use crate::boundary::{BoundaryOptions, limiting_depth};
+use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_dynamics::Cut;
@@ -143,12 +143,7 @@ impl CutsLikelihood {
         let Ok(model) = self.parameterization.model(theta) else {
             return f64::NEG_INFINITY;
         };
-        let Ok(boundaries) = self
-            .speeds_rpm
-            .iter()
-            .map(|&s| limiting_depth(&model, s, &self.options))
-            .collect::<Result<Vec<_>>>()
-        else {
+        let Ok(boundaries) = limiting_depths(&model, &self.speeds_rpm, &self.options) else {
             return f64::NEG_INFINITY;
         };
         self.cuts

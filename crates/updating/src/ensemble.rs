@@ -23,7 +23,7 @@
 //! grid depth with P_s >= P_test) the test is the point of maximum material removal rate; testing
 //! stops when the next test would improve the best stable MRR by less than 10 %.
 
-use crate::boundary::{BoundaryOptions, limiting_depth};
+use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::classes::{Sampler, SamplerOptions, sample_posterior};
 use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
@@ -268,10 +268,7 @@ impl BoundaryEnsemble {
             .models
             .par_iter()
             .map(|m| {
-                let row = new
-                    .iter()
-                    .map(|&s| limiting_depth(m, s, &self.options))
-                    .collect::<Result<Vec<_>>>();
+                let row = limiting_depths(m, &new, &self.options);
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 observer.paths_done(k, total);
                 row

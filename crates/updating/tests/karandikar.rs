@@ -1,8 +1,9 @@
 //! Seed 003: random-walk path updating of the process-damping coefficient C and value-of-
 //! information test selection, on cut results generated from a known C.
 //!
-//! The machine is a 003-like flexure (228 Hz, single-tooth 18.54 mm cutter, 50 % up milling; the
-//! flexure's stiffness and damping are not given in the text and are chosen here), kt, kn and the
+//! The machine is the 003-like flexure of `chatter_dynamics::examples::process_damping_flexure`
+//! (228 Hz, single-tooth 18.54 mm cutter, 50 % up milling; the flexure's stiffness and damping
+//! are not given in the text and are chosen there), kt, kn and the
 //! priors of 003 (kt ~ N(2111.2, 78.3), kn ~ N(1052.6, 27.9) N/mm^2, C ~ U(0.5e5, 10e5) N/m,
 //! sigma = 0.5 mm, depths up to 7.5 mm). The cut results come from the true C = 2.5e5 N/m with the
 //! iterative process-damping algorithm of `chatter-stability` (not the path solver).
@@ -10,9 +11,7 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_bayes::prior::{IndependentPrior, Marginal};
-use chatter_dynamics::{
-    Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
-};
+use chatter_dynamics::{Cut, ModalModel, examples};
 use chatter_stability::process_damping::process_damping_limiting_depth;
 use chatter_updating::boundary::BoundaryOptions;
 use chatter_updating::cuts::CutKernel;
@@ -23,26 +22,7 @@ use std::collections::BTreeMap;
 const TRUE_C: f64 = 2.5e5;
 
 fn flexure() -> ModalModel {
-    let mode = Mode::new(
-        228.0,
-        0.02,
-        ModeShape::Directional {
-            coordinate: 0,
-            stiffness_n_per_m: 5.6e6,
-        },
-    )
-    .unwrap();
-    let op = Operation::Milling(
-        Milling::new(1, 0.5, MillingDirection::Up, Some(18.54e-3), None).unwrap(),
-    );
-    ModalModel::new(
-        Some("003-like flexure".into()),
-        op,
-        CuttingCoefficients::new(2111.2e6, 1052.6e6).unwrap(),
-        vec![mode],
-        Some(TRUE_C),
-    )
-    .unwrap()
+    examples::process_damping_flexure(Some(TRUE_C))
 }
 
 /// The machine: stable below the true process-damped limit (cached per speed).

@@ -1,0 +1,304 @@
+//! The oriented frequency response of the zero-order method (Altintas and Budak 1995): the two
+//! eigenvalues Lambda(w) of A_0 G(i w), with A_0 the delay-averaged directional matrix (N/m^2)
+//! and G the receptance of 000 Eq. 1,
+//!
+//! G(i w) = sum_n phi_n phi_n^T / (w_n^2 - w^2 + 2 i zeta_n w_n w),
+//!
+//! over mass-normalized mode shapes phi_n. Process damping (003 Section 2) enters as the
+//! equivalent damping ratios zeta_n + b s_n of [`crate::process_damping::with_equivalent_damping`],
+//! with s_n = d zeta_n / d b from [`crate::process_damping::damping_ratio_slope_per_m`].
+//!
+//! Where Re(Lambda) < 0 the eigenvalue is a point of a lobe: the phase
+//! eps = (2 arg(Lambda) - pi) mod 4 pi lies in (0, 2 pi) and the depth is b = -1 / (2 Re(Lambda)).
+
+use crate::error::{Result, invalid};
+use chatter_dynamics::ModalModel;
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// Real parts above this fraction of the pair's size (|Lambda_1|^2 + |Lambda_2|^2)^(1/2) below zero
+/// count as rounding, so a zero eigenvalue (every mode along one direction) is not a lobe.
+const ROUNDING: f64 = 1e-10;
+
+/// One vibration mode as the zero-order method sees it (000 Eq. 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModalTerm {
+    /// Natural frequency w_n (rad/s).
+    pub omega_rad_s: f64,
+    /// Damping ratio zeta_n (structural; process damping is added per depth).
+    pub damping_ratio: f64,
+    /// Mass-normalized shape phi_n over the two coordinates (1/sqrt(kg)).
+    pub shape: [f64; 2],
+}
+
+/// The structure and the averaged cutting forces of a zero-order problem.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrientedSystem {
+    modes: Vec<ModalTerm>,
+    directional_n_per_m2: [[f64; 2]; 2],
+}
+
+/// Process damping folded into the modal damping ratios at one depth: zeta_n + b s_n.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AddedDamping<'a> {
+    /// s_n = d zeta_n / d b per mode (1/m); empty for none.
+    pub slopes_per_m: &'a [f64],
+    /// b (m).
+    pub depth_m: f64,
+}
+
+impl AddedDamping<'_> {
+    /// No process damping.
+    pub const NONE: AddedDamping<'static> = AddedDamping {
+        slopes_per_m: &[],
+        depth_m: 0.0,
+    };
+
+    /// The damping ratio of mode `n`, or None where the added damping takes it to 1 (no finite
+    /// fixed point there, as in [`crate::process_damping::process_damping_limiting_depth`]).
+    fn damping_ratio(&self, n: usize, mode: &ModalTerm) -> Option<f64> {
+        let slope = self.slopes_per_m.get(n).copied().unwrap_or(0.0);
+        let zeta = mode.damping_ratio + self.depth_m * slope;
+        (slope <= 0.0 || zeta < 1.0).then_some(zeta)
+    }
+}
+
+/// The eigenvalue pair of A_0 G(i w) at one frequency.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EigenPair(pub [Complex64; 2]);
+
+/// A point of a lobe: the phase eps in (0, 2 pi) and the depth b (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LobePhase {
+    pub eps: f64,
+    pub depth_m: f64,
+}
+
+impl EigenPair {
+    /// The pair ordered to continue `previous` (the sum of distances is the smaller one).
+    pub fn matched(self, previous: &EigenPair) -> Self {
+        let ([a, b], [p, q]) = (self.0, previous.0);
+        if (b - p).norm_sqr() + (a - q).norm_sqr() < (a - p).norm_sqr() + (b - q).norm_sqr() {
+            Self([b, a])
+        } else {
+            self
+        }
+    }
+
+    /// The eigenvalue closest to `reference`.
+    pub fn closest(&self, reference: Complex64) -> usize {
+        let [a, b] = self.0;
+        usize::from((b - reference).norm_sqr() < (a - reference).norm_sqr())
+    }
+
+    /// Whether eigenvalue `branch` has a real part negative beyond rounding.
+    pub fn is_lobe(&self, branch: usize) -> bool {
+        let re = self.0[branch].re;
+        re < 0.0 && re * re > ROUNDING * ROUNDING * (self.0[0].norm_sqr() + self.0[1].norm_sqr())
+    }
+
+    /// The lobe point of eigenvalue `branch`, or None where it is not a lobe
+    /// ([`Self::is_lobe`]).
+    pub fn lobe(&self, branch: usize) -> Option<LobePhase> {
+        let l = self.0[branch];
+        self.is_lobe(branch).then(|| {
+            // 2 arg - pi lies in (-3 pi, pi]: one turn of 4 pi brings it to [0, 4 pi)
+            let e = 2.0 * l.arg() - PI;
+            LobePhase {
+                eps: if e < 0.0 { e + 4.0 * PI } else { e },
+                depth_m: -0.5 / l.re,
+            }
+        })
+    }
+}
+
+impl ModalTerm {
+    fn validate(&self) -> Result<()> {
+        if !(self.omega_rad_s.is_finite() && self.omega_rad_s > 0.0) {
+            return invalid("omega_rad_s", self.omega_rad_s, "a natural frequency > 0");
+        }
+        if !(self.damping_ratio.is_finite() && self.damping_ratio >= 0.0) {
+            return invalid("damping_ratio", self.damping_ratio, "a damping ratio >= 0");
+        }
+        match self.shape.iter().find(|v| !v.is_finite()) {
+            Some(&v) => invalid("shape", v, "a finite mode shape"),
+            None => Ok(()),
+        }
+    }
+}
+
+impl OrientedSystem {
+    /// A system from its modes and the averaged directional matrix A_0 (N/m^2; K_c for turning).
+    pub fn new(modes: Vec<ModalTerm>, directional_n_per_m2: [[f64; 2]; 2]) -> Result<Self> {
+        if modes.is_empty() {
+            return invalid("modes", 0.0, "at least one mode");
+        }
+        for m in &modes {
+            m.validate()?;
+        }
+        if let Some(&v) = directional_n_per_m2
+            .iter()
+            .flatten()
+            .find(|v| !v.is_finite())
+        {
+            return invalid("directional_n_per_m2", v, "a finite directional matrix");
+        }
+        Ok(Self {
+            modes,
+            directional_n_per_m2,
+        })
+    }
+
+    /// The system of `model`: its modes and [`ModalModel::average_directional_matrix`].
+    pub fn from_model(model: &ModalModel) -> Result<Self> {
+        let a = model.average_directional_matrix();
+        let modes = model
+            .modes()
+            .iter()
+            .map(|m| ModalTerm {
+                omega_rad_s: m.omega_rad_s(),
+                damping_ratio: m.damping_ratio(),
+                shape: m.mass_normalized_shape(),
+            })
+            .collect();
+        Self::new(modes, [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]])
+    }
+
+    /// The modes.
+    pub fn modes(&self) -> &[ModalTerm] {
+        &self.modes
+    }
+
+    /// The natural frequencies (Hz), lowest and highest.
+    pub(crate) fn frequency_span_hz(&self) -> (f64, f64) {
+        self.modes
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
+                let f = m.omega_rad_s / (2.0 * PI);
+                (lo.min(f), hi.max(f))
+            })
+    }
+
+    /// Eigenvalues of A_0 G(i w) with `added` process damping; None where a damping ratio
+    /// raised by process damping reaches 1.
+    pub(crate) fn eigenvalues(&self, omega_rad_s: f64, added: AddedDamping) -> Option<EigenPair> {
+        let w = omega_rad_s;
+        // symmetric receptance: g00, g01, g11
+        let mut g = [Complex64::new(0.0, 0.0); 3];
+        for (n, m) in self.modes.iter().enumerate() {
+            let zeta = added.damping_ratio(n, m)?;
+            let wn = m.omega_rad_s;
+            let inv = Complex64::new(wn * wn - w * w, 2.0 * zeta * wn * w).inv();
+            let [p, q] = m.shape;
+            g[0] += inv * (p * p);
+            g[1] += inv * (p * q);
+            g[2] += inv * (q * q);
+        }
+        let a = &self.directional_n_per_m2;
+        let m00 = g[0] * a[0][0] + g[1] * a[0][1];
+        let m01 = g[1] * a[0][0] + g[2] * a[0][1];
+        let m10 = g[0] * a[1][0] + g[1] * a[1][1];
+        let m11 = g[1] * a[1][0] + g[2] * a[1][1];
+        let half_trace = 0.5 * (m00 + m11);
+        let disc = principal_sqrt(half_trace * half_trace - (m00 * m11 - m01 * m10));
+        Some(EigenPair([half_trace + disc, half_trace - disc]))
+    }
+}
+
+/// The principal square root of `z` in Cartesian form, sqrt(z) = t + i b / (2 t) with
+/// t = sqrt((|z| + Re z) / 2) (mirrored for Re z < 0), which avoids the polar form's
+/// trigonometric functions.
+fn principal_sqrt(z: Complex64) -> Complex64 {
+    // |z| without hypot's care for overflow, unless it is needed
+    let modulus = match z.norm_sqr().sqrt() {
+        m if m.is_finite() && m > f64::MIN_POSITIVE => m,
+        _ => z.re.hypot(z.im),
+    };
+    if modulus == 0.0 {
+        return Complex64::new(0.0, 0.0);
+    }
+    let t = (0.5 * (modulus + z.re.abs())).sqrt();
+    if z.re >= 0.0 {
+        Complex64::new(t, 0.5 * z.im / t)
+    } else {
+        Complex64::new(0.5 * z.im.abs() / t, t.copysign(z.im))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use chatter_dynamics::examples;
+
+    #[test]
+    fn eigenvalues_of_a_single_direction_are_the_oriented_frf() {
+        // turning: A_0 = K_c maps the feed coordinate only, so one eigenvalue is zero (not a
+        // lobe)
+        let model = examples::ahmadi_2022_turning();
+        let system = OrientedSystem::from_model(&model).unwrap();
+        let a = model.average_directional_matrix();
+        let f = 2400.0;
+        let pair = system
+            .eigenvalues(2.0 * PI * f, AddedDamping::NONE)
+            .unwrap();
+        // A_0 has rank one, so the other eigenvalue is trace(A_0 G)
+        let g = model.receptance_matrix(f);
+        let expected = (0..2)
+            .flat_map(|r| (0..2).map(move |k| (r, k)))
+            .map(|(r, k)| g[k][r] * a[(r, k)])
+            .sum::<Complex64>();
+        let k = pair.closest(expected);
+        assert!((pair.0[k] - expected).norm() < 1e-12 * expected.norm());
+        assert!(pair.lobe(1 - k).is_none());
+    }
+
+    #[test]
+    fn principal_square_root_matches_the_polar_form() {
+        for (re, im) in [
+            (4.0, 0.0),
+            (-4.0, 0.0),
+            (-4.0, -0.0),
+            (3.0, 4.0),
+            (-3.0, 4.0),
+            (-3.0, -4.0),
+            (1e-300, -2e-300),
+            (0.0, 0.0),
+        ] {
+            let z = Complex64::new(re, im);
+            let (ours, polar) = (principal_sqrt(z), z.sqrt());
+            assert!(
+                (ours - polar).norm() <= 1e-15 * polar.norm(),
+                "{z}: {ours} vs {polar}"
+            );
+        }
+    }
+
+    #[test]
+    fn invalid_terms_are_rejected() {
+        let good = ModalTerm {
+            omega_rad_s: 1000.0,
+            damping_ratio: 0.02,
+            shape: [1.0, 0.0],
+        };
+        let a = [[1e9, 0.0], [0.0, 0.0]];
+        assert!(OrientedSystem::new(vec![good], a).is_ok());
+        assert!(OrientedSystem::new(vec![], a).is_err());
+        for bad in [
+            ModalTerm {
+                omega_rad_s: -1.0,
+                ..good
+            },
+            ModalTerm {
+                damping_ratio: f64::NAN,
+                ..good
+            },
+            ModalTerm {
+                shape: [f64::INFINITY, 0.0],
+                ..good
+            },
+        ] {
+            assert!(OrientedSystem::new(vec![bad], a).is_err());
+        }
+        assert!(OrientedSystem::new(vec![good], [[f64::NAN, 0.0], [0.0, 0.0]]).is_err());
+    }
+}
