@@ -28,6 +28,26 @@ fn fail(command: &mut Command) -> String {
     err
 }
 
+/// `chatter update --quiet OPTIONS --model MODEL --observations OBSERVATIONS --out OUT`.
+fn update(
+    options: &[&str],
+    model: impl AsRef<std::ffi::OsStr>,
+    observations: impl AsRef<std::ffi::OsStr>,
+    out: impl AsRef<std::ffi::OsStr>,
+) -> Command {
+    let mut command = chatter();
+    command
+        .args(["update", "--quiet"])
+        .args(options)
+        .arg("--model")
+        .arg(model)
+        .arg("--observations")
+        .arg(observations)
+        .arg("--out")
+        .arg(out);
+    command
+}
+
 fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -395,25 +415,12 @@ fn diagnose_rejects_bad_input() {
 fn update_writes_posterior_summary_model_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("posterior");
-    succeed(
-        chatter()
-            .args([
-                "update",
-                "--quiet",
-                "--classes",
-                "0.5,1",
-                "--samples",
-                "200",
-                "--seed",
-                "3",
-                "--model",
-            ])
-            .arg(example("ahmadi2022_turning_model.json"))
-            .arg("--observations")
-            .arg(example("ahmadi2022_turning_observations.json"))
-            .arg("--out")
-            .arg(&out_dir),
-    );
+    succeed(&mut update(
+        &["--classes", "0.5,1", "--samples", "200", "--seed", "3"],
+        example("ahmadi2022_turning_model.json"),
+        example("ahmadi2022_turning_observations.json"),
+        &out_dir,
+    ));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
@@ -461,29 +468,23 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     // identified milling poles with TMCMC (002)
     let out_dir = dir.path().join("tmcmc");
-    succeed(
-        chatter()
-            .args([
-                "update",
-                "--quiet",
-                "--sampler",
-                "tmcmc",
-                "--classes",
-                "0.01",
-                "--samples",
-                "40",
-                "--seed",
-                "1",
-                "--parameters",
-                "theta_omega_1,theta_zeta_1",
-                "--model",
-            ])
-            .arg(example("ebrahimi2025_milling_model.json"))
-            .arg("--observations")
-            .arg(example("ebrahimi2025_milling_observations.json"))
-            .arg("--out")
-            .arg(&out_dir),
-    );
+    succeed(&mut update(
+        &[
+            "--sampler",
+            "tmcmc",
+            "--classes",
+            "0.01",
+            "--samples",
+            "40",
+            "--seed",
+            "1",
+            "--parameters",
+            "theta_omega_1,theta_zeta_1",
+        ],
+        example("ebrahimi2025_milling_model.json"),
+        example("ebrahimi2025_milling_observations.json"),
+        &out_dir,
+    ));
     let summary = std::fs::read_to_string(out_dir.join("summary.json")).unwrap();
     assert!(summary.contains("sigma_w2_hz2"), "{summary}");
     // cut results with rejection sampling + adaptive MCMC (004): one class, no alpha
@@ -494,27 +495,21 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
     )
     .unwrap();
     let out_dir = dir.path().join("amcmc");
-    succeed(
-        chatter()
-            .args([
-                "update",
-                "--quiet",
-                "--sampler",
-                "amcmc",
-                "--samples",
-                "60",
-                "--seed",
-                "1",
-                "--parameters",
-                "kn_n_per_mm2",
-                "--model",
-            ])
-            .arg(example("ebrahimi2025_milling_model.json"))
-            .arg("--observations")
-            .arg(&cuts)
-            .arg("--out")
-            .arg(&out_dir),
-    );
+    succeed(&mut update(
+        &[
+            "--sampler",
+            "amcmc",
+            "--samples",
+            "60",
+            "--seed",
+            "1",
+            "--parameters",
+            "kn_n_per_mm2",
+        ],
+        example("ebrahimi2025_milling_model.json"),
+        &cuts,
+        &out_dir,
+    ));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
@@ -532,22 +527,13 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
         vec!["--parameters".to_string(), "theta_bogus_1".to_string()],
     ] {
         let err = fail(
-            chatter()
-                .args([
-                    "update",
-                    "--quiet",
-                    "--samples",
-                    "20",
-                    "--seed",
-                    "1",
-                    "--model",
-                ])
-                .arg(example("ahmadi2022_turning_model.json"))
-                .arg("--observations")
-                .arg(example("ahmadi2022_turning_observations.json"))
-                .arg("--out")
-                .arg(dir.path().join("never"))
-                .args(&extra),
+            update(
+                &["--samples", "20", "--seed", "1"],
+                example("ahmadi2022_turning_model.json"),
+                example("ahmadi2022_turning_observations.json"),
+                dir.path().join("never"),
+            )
+            .args(&extra),
         );
         assert!(
             err.contains("abc") || err.contains("theta_k_7") || err.contains("theta_bogus_1"),
