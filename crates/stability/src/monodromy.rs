@@ -809,7 +809,7 @@ fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
 const ARNOLDI_DIM: usize = 20;
 /// Krylov dimensions within a cycle at which convergence is tested (the small Hessenberg
 /// eigenproblem costs O(k^3), so most operators stop well before [`ARNOLDI_DIM`]).
-const ARNOLDI_CHECKS: [usize; 3] = [9, 14, ARNOLDI_DIM];
+const ARNOLDI_CHECKS: [usize; 4] = [8, 12, 16, ARNOLDI_DIM];
 /// Maximum restarts.
 const ARNOLDI_RESTARTS: usize = 40;
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
