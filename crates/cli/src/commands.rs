@@ -375,8 +375,14 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     // 4. Sim-to-real gap: a synthetic shop-floor campaign of a milling machine whose process
     //    damping the nominal model leaves out, diagnosed from the nominal model and the data.
     let nominal = chatter_gap::nominal_milling()?;
-    let hidden = chatter_gap::HiddenEffect::ProcessDamping { c_n_per_m: 6e4 };
-    let campaign = chatter_gap::synthesize(&nominal, &chatter_gap::Scenario::new(hidden, 101))?;
+    let mut scenario = chatter_gap::Scenario::new(chatter_gap::HiddenEffect::ParameterError, 101);
+    (scenario.effect, _) = chatter_gap::generator::effect_at(
+        chatter_gap::EffectClass::ProcessDamping,
+        2.0,
+        &nominal,
+        scenario.speed_range_rpm,
+    )?;
+    let campaign = chatter_gap::synthesize(&nominal, &scenario)?;
     let model_path = out_dir.join("shopfloor_model.json");
     write_atomic(
         &model_path,
@@ -394,9 +400,9 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         model: &model_path,
         observations: &obs_path,
         seed: 1,
-        samples: 250,
+        samples: 120,
         validation: crate::diagnose::ValidationArg::Kfold,
-        folds: 4,
+        folds: 3,
         out: Some(&diagnosis_dir),
         quiet,
     })?;

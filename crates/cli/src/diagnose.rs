@@ -48,6 +48,8 @@ struct Report<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     validation: Option<&'a chatter_gap::shrink::ValidationReport>,
     predictive_check: &'a chatter_gap::PredictiveCheck,
+    nominal_log_evidence: f64,
+    nominal_check: &'a chatter_gap::PredictiveCheck,
     notes: &'a [String],
 }
 
@@ -121,11 +123,29 @@ pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String)> {
         shrink: d.shrink.as_ref(),
         validation: d.validation.as_ref(),
         predictive_check: &d.predictive_check,
+        nominal_log_evidence: d.nominal_log_evidence,
+        nominal_check: &d.nominal_check,
         notes: &d.notes,
     };
     if let Some(dir) = r.out {
         let full = serde_json::to_string_pretty(&diagnosis)?;
         write_atomic(&dir.join("diagnosis.json"), full.as_bytes())?;
+        write_atomic(
+            &dir.join("diagnosed_model.json"),
+            diagnosis.diagnosed_model().to_json_string().as_bytes(),
+        )?;
+        let (softening_per_rpm2, drift_rate) = diagnosis.diagnosed_effects();
+        if softening_per_rpm2 != 0.0 || drift_rate != 0.0 {
+            let effects = serde_json::json!({
+                "note": "effects of the diagnosed machine that a model file does not hold yet",
+                "natural_frequency_softening_per_rpm2": softening_per_rpm2,
+                "cutting_coefficient_drift_over_campaign": drift_rate,
+            });
+            write_atomic(
+                &dir.join("diagnosed_effects.json"),
+                serde_json::to_string_pretty(&effects)?.as_bytes(),
+            )?;
+        }
         lobe_plot(&diagnosis, &dir.join("lobes.svg"))?;
         residual_map(&diagnosis, &dir.join("residuals.svg"))?;
     }
@@ -145,8 +165,8 @@ fn lobe_plot(d: &Diagnosis, path: &Path) -> Result<()> {
     } else {
         (0.8 * hi.max(1.0), 1.2 * hi.max(1.0))
     };
-    let speeds: Vec<f64> = (0..400)
-        .map(|i| lo + (hi - lo) * i as f64 / 399.0)
+    let speeds: Vec<f64> = (0..200)
+        .map(|i| lo + (hi - lo) * i as f64 / 199.0)
         .collect();
     let lobes = d.lobes(&speeds);
     let series = [

@@ -204,13 +204,13 @@ enum Command {
         #[arg(long)]
         seed: u64,
         /// iTMCMC samples per model class.
-        #[arg(long, default_value_t = 250)]
+        #[arg(long, default_value_t = 120)]
         samples: usize,
         /// Held-out validation of the shrinkage.
         #[arg(long, value_enum, default_value = "kfold")]
         validation: diagnose::ValidationArg,
         /// Folds (or speed bands) of the validation.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 3)]
         folds: usize,
         /// Folder for diagnosis.json (with residuals), lobes.svg and residuals.svg.
         #[arg(long)]

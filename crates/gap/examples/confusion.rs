@@ -1,161 +1,220 @@
-//! The confusion matrix and the shrink figures of the diagnosis over synthetic campaigns: every
-//! class at three magnitudes, two pure parameter errors and two strengths of runout (outside the
-//! candidate list).
+//! The confusion matrix of the diagnosis over the proving ground: every machine of
+//! [`proving_machines`], a control (the nominal model is right), every class at magnitudes
+//! 0.5x, 1x and 2x, and effects outside the candidate list (cutting coefficients x3 in a speed
+//! band; runout, half the teeth cutting). The truth is the semi-discretization at 4x resolution
+//! (the diagnosis uses the full discretization); held-out cuts drawn from the truth measure how
+//! much of the nominal model's misclassification the diagnosed model closes.
 //!
-//! `cargo run --release -p chatter-gap --example confusion [-- --quick]` (`--quick` skips the
-//! held-out validation).
+//! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1]`
 
+use chatter_gap::generator::{effect_at, proving_machines, true_variant};
 use chatter_gap::{
-    DiagnoseOptions, HiddenEffect, Quiet, Recalibration, Scenario, Validation, diagnose,
-    nominal_milling, synthesize,
+    DiagnoseOptions, DiagnosisObserver, EffectClass, HiddenEffect, Recalibration, Scenario,
+    Validation, Variant, diagnose, synthesize,
 };
+use chatter_stability::StabilitySolver;
+use chatter_stability::monodromy::Discretization;
 use std::collections::BTreeMap;
+use std::time::Instant;
+
+fn arg(name: &str) -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1).cloned())
+}
+
+fn list<T: std::str::FromStr>(name: &str, default: Vec<T>) -> Vec<T> {
+    arg(name).map_or(default, |s| {
+        s.split(',').filter_map(|x| x.parse().ok()).collect()
+    })
+}
+
+/// Whether `variant` predicts chatter at a cut (full discretization), None on failure.
+fn chatters(variant: &Variant, speed_rpm: f64, depth_m: f64, u: f64) -> Option<bool> {
+    let model = variant.at(None, speed_rpm, u).ok()?;
+    let mu = Discretization::full()
+        .dominant_multiplier(&model, speed_rpm, depth_m)
+        .ok()?;
+    Some(mu.modulus() > 1.0)
+}
+
+/// Balanced misclassification of `variant` on labelled cuts.
+fn balanced_misclassification(variant: &Variant, cuts: &[(f64, f64, f64, bool)]) -> f64 {
+    let (mut miss_u, mut n_u, mut miss_s, mut n_s) = (0, 0, 0, 0);
+    for &(s, b, u, stable) in cuts {
+        let predicted_chatter = chatters(variant, s, b, u).unwrap_or(false);
+        if stable {
+            n_s += 1;
+            miss_s += usize::from(predicted_chatter);
+        } else {
+            n_u += 1;
+            miss_u += usize::from(!predicted_chatter);
+        }
+    }
+    let rate = |m: usize, n: usize| if n == 0 { 0.0 } else { m as f64 / n as f64 };
+    0.5 * (rate(miss_u, n_u) + rate(miss_s, n_s))
+}
+
+/// Prints each class's evidence and the time since the diagnosis started (stderr).
+struct Log(Instant);
+impl DiagnosisObserver for Log {
+    fn class_done(&self, class: EffectClass, log_evidence: f64) {
+        eprintln!(
+            "  {class}: ln Z {log_evidence:.1} at {:.1} s",
+            self.0.elapsed().as_secs_f64()
+        );
+    }
+}
 
 fn main() -> chatter_gap::Result<()> {
-    let quick = std::env::args().any(|a| a == "--quick");
-    let nominal = nominal_milling()?;
-    let none = Recalibration::default();
-    let mut cases: Vec<(String, HiddenEffect, Recalibration)> = vec![
-        (
-            "parameter error A".into(),
+    let machines = proving_machines()?;
+    let pick: Vec<usize> = list("--machines", (0..machines.len()).collect());
+    let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
+    let magnitudes: Vec<f64> = list("--magnitudes", vec![0.5, 1.0, 2.0]);
+    let classes: Vec<EffectClass> = list("--classes", EffectClass::ALL.to_vec());
+    let defaults = DiagnoseOptions::default();
+    let options = DiagnoseOptions {
+        validation: Validation::Off,
+        samples: arg("--samples")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(defaults.samples),
+        steps: arg("--steps")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(defaults.steps),
+        ..defaults
+    };
+    // (machine, magnitude label) -> (right, total)
+    let mut table: BTreeMap<(String, String), (usize, usize)> = BTreeMap::new();
+    let mut closures = Vec::new();
+    let mut times = Vec::new();
+    println!("machine | case | magnitude | expected | verdict | seconds | held-out closure");
+    for &mi in &pick {
+        let machine = &machines[mi];
+        let (lo, hi) = machine.speed_range_rpm;
+        let mut cases: Vec<(String, String, HiddenEffect, Recalibration)> = vec![(
+            "control".into(),
+            "control".into(),
             HiddenEffect::ParameterError,
-            Recalibration {
-                frequency_factor: 0.97,
-                damping_factor: 1.5,
-                cutting_over_stiffness_factor: 0.8,
-            },
-        ),
-        (
-            "parameter error B".into(),
-            HiddenEffect::ParameterError,
-            Recalibration {
-                frequency_factor: 1.03,
-                damping_factor: 0.7,
-                cutting_over_stiffness_factor: 1.25,
-            },
-        ),
-    ];
-    for c in [2e4, 4e4, 6e4] {
-        cases.push((
-            format!("process damping C {c:.0} N/m"),
-            HiddenEffect::ProcessDamping { c_n_per_m: c },
-            none,
-        ));
-    }
-    for drop in [0.02, 0.04, 0.06] {
-        cases.push((
-            format!("speed-dependent, drop {:.0} %", drop * 100.0),
-            HiddenEffect::SpeedDependentDynamics {
-                frequency_drop_at_max_speed: drop,
-            },
-            none,
-        ));
-    }
-    for k in [1.6e7, 8e6, 4e6] {
-        cases.push((
-            format!("extra mode 1150 Hz, k {k:.1e} N/m"),
-            HiddenEffect::ExtraMode {
-                frequency_hz: 1150.0,
-                damping_ratio: 0.02,
-                stiffness_n_per_m: k,
-                direction_deg: 30.0,
-            },
-            none,
-        ));
-    }
-    for r in [0.2, 0.4, 0.6] {
-        cases.push((
-            format!("drift {:+.0} %", r * 100.0),
-            HiddenEffect::Drift {
-                cutting_change_over_campaign: r,
-            },
-            none,
-        ));
-    }
-    for teeth in [2, 1] {
-        cases.push((
-            format!("runout, {teeth} of 4 teeth cut"),
-            HiddenEffect::Runout {
-                cutting_teeth: teeth,
-            },
-            none,
-        ));
-    }
-    let names = [
-        "parameter_error",
-        "process_damping",
-        "speed_dependent_dynamics",
-        "extra_mode",
-        "drift",
-        "unexplained",
-    ];
-    let mut matrix: BTreeMap<(&str, &str), usize> = BTreeMap::new();
-    println!(
-        "{:<36} {:<26} {:>6}  {:>17}  {:>17}  {:>15}  {:>15}",
-        "case", "verdict", "p", "misclass. b->a", "lpd/obs b->a", "chatter Hz", "pole Hz"
-    );
-    for (k, (name, effect, error)) in cases.iter().enumerate() {
-        let mut scenario = Scenario::new(*effect, 1000 + k as u64);
-        scenario.error = *error;
-        let data = synthesize(&nominal, &scenario)?;
-        let options = DiagnoseOptions {
-            seed: k as u64,
-            validation: if quick {
-                Validation::Off
-            } else {
-                Validation::KFold { folds: 5 }
-            },
-            ..DiagnoseOptions::default()
-        };
-        let d = diagnose(&nominal, &data, &options, &Quiet)?;
-        let p = d
-            .classes
-            .iter()
-            .find(|c| c.name == d.best_class)
-            .map_or(0.0, |c| c.probability);
-        let pair = |m: Option<chatter_gap::shrink::Metric>| {
-            m.map_or("-".to_string(), |m| {
-                format!("{:.3} -> {:.3}", m.before, m.after)
-            })
-        };
-        let (bmr, lpd, fc, pf) = match &d.shrink {
-            Some(s) => (
-                pair(s.balanced_misclassification),
-                pair(Some(s.log_predictive_density_per_observation)),
-                pair(s.rms_chatter_residual_hz),
-                pair(s.rms_pole_frequency_residual_hz),
-            ),
-            None => Default::default(),
-        };
-        println!(
-            "{name:<36} {:<26} {p:>6.3}  {bmr:>17}  {lpd:>17}  {fc:>15}  {pf:>15}",
-            d.verdict.name()
-        );
-        let truth = names
-            .iter()
-            .find(|n| **n == effect.expected_verdict())
-            .copied()
-            .unwrap_or("unexplained");
-        let verdict = names
-            .iter()
-            .find(|n| **n == d.verdict.name())
-            .copied()
-            .unwrap_or("unexplained");
-        *matrix.entry((truth, verdict)).or_default() += 1;
-    }
-    println!("\nconfusion matrix (rows: hidden effect, columns: verdict)");
-    let short = ["param", "pd", "speed", "extra", "drift", "unexpl"];
-    print!("{:<26}", "");
-    for s in short {
-        print!("{s:>8}");
-    }
-    println!();
-    for truth in names {
-        print!("{truth:<26}");
-        for verdict in names {
-            print!("{:>8}", matrix.get(&(truth, verdict)).copied().unwrap_or(0));
+            Recalibration::default(),
+        )];
+        for &class in &classes {
+            if class == EffectClass::ProcessDamping
+                && machine.model.operation().cutting_diameter_m().is_none()
+            {
+                continue;
+            }
+            for &m in &magnitudes {
+                let (effect, error) = effect_at(class, m, &machine.model, (lo, hi))?;
+                cases.push((class.name().into(), format!("{m}x"), effect, error));
+            }
         }
-        println!();
+        cases.push((
+            "cutting x3 in a band".into(),
+            "outside".into(),
+            HiddenEffect::CuttingBand {
+                from_rpm: lo + 0.4 * (hi - lo),
+                to_rpm: lo + 0.7 * (hi - lo),
+                factor: 3.0,
+            },
+            Recalibration::default(),
+        ));
+        if let chatter_dynamics::Operation::Milling(op) = machine.model.operation()
+            && op.teeth() % 2 == 0
+        {
+            cases.push((
+                "runout".into(),
+                "outside".into(),
+                HiddenEffect::Runout {
+                    cutting_teeth: op.teeth() / 2,
+                },
+                Recalibration::default(),
+            ));
+        }
+        for (name, magnitude, effect, error) in cases {
+            for seed in 0..seeds {
+                let mut scenario = Scenario::new(effect, 1000 + seed).with_speed_range(lo, hi, 4);
+                scenario.error = error;
+                let start = Instant::now();
+                let data = synthesize(&machine.model, &scenario)?;
+                eprintln!("synthesized in {:.1} s", start.elapsed().as_secs_f64());
+                let start = Instant::now();
+                let options = DiagnoseOptions {
+                    seed,
+                    ..options.clone()
+                };
+                let d = diagnose(&machine.model, &data, &options, &Log(Instant::now()))?;
+                let seconds = start.elapsed().as_secs_f64();
+                times.push(seconds);
+                let expected = effect.expected_verdict(&error);
+                let right = d.verdict.name() == expected;
+                // held-out cuts from the truth, labelled without noise
+                let mut held = Scenario::new(effect, 5000 + seed).with_speed_range(lo, hi, 0);
+                held.error = error;
+                held.pole_depth_fractions.clear();
+                held.label_width_log_depth = 1e-6;
+                let held_out = synthesize(&machine.model, &held)?;
+                let n = held_out.cuts.len().max(2) as f64 - 1.0;
+                let cuts: Vec<(f64, f64, f64, bool)> = held_out
+                    .cuts
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| (c.speed_rpm, c.depth_mm * 1e-3, k as f64 / n, c.stable))
+                    .collect();
+                let truth = true_variant(&machine.model, &held)?;
+                let nominal = Variant::new(machine.model.clone());
+                let before = balanced_misclassification(&nominal, &cuts);
+                let after = balanced_misclassification(d.diagnosed_variant(), &cuts);
+                let best = balanced_misclassification(&truth, &cuts);
+                let closure = if before - best > 0.02 {
+                    let c = (before - after) / (before - best);
+                    closures.push(c);
+                    format!("{c:.2} ({before:.2} -> {after:.2}, truth {best:.2})")
+                } else {
+                    format!("- ({before:.2} -> {after:.2}, truth {best:.2})")
+                };
+                println!(
+                    "{} | {name} | {magnitude} | {expected} | {} | {seconds:.1} | {closure}",
+                    machine.name,
+                    d.verdict.name(),
+                );
+                let e = table
+                    .entry((machine.name.to_string(), magnitude.clone()))
+                    .or_default();
+                e.0 += usize::from(right);
+                e.1 += 1;
+            }
+        }
     }
+    println!("\nright verdicts by machine and magnitude:");
+    for ((machine, magnitude), (right, total)) in &table {
+        println!("{machine} | {magnitude} | {right}/{total}");
+    }
+    let mut by_magnitude: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+    for ((_, magnitude), (right, total)) in &table {
+        let e = by_magnitude.entry(magnitude.as_str()).or_default();
+        e.0 += right;
+        e.1 += total;
+    }
+    for (magnitude, (right, total)) in by_magnitude {
+        println!(
+            "all machines | {magnitude} | {right}/{total} ({:.0} %)",
+            100.0 * right as f64 / total.max(1) as f64
+        );
+    }
+    closures.sort_by(f64::total_cmp);
+    if !closures.is_empty() {
+        println!(
+            "median held-out closure {:.2} over {} campaigns with a gap",
+            closures[closures.len() / 2],
+            closures.len()
+        );
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "diagnosis time: median {:.1} s, max {:.1} s",
+        times[times.len() / 2],
+        times.last().copied().unwrap_or(0.0)
+    );
     Ok(())
 }

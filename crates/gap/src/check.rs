@@ -9,7 +9,8 @@
 //! family-wise level divided by the number of observable types (Bonferroni).
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, Prediction, folded, matched_pole};
+use crate::likelihood::{NoiseModel, chatter_residual, pole_residuals};
+use crate::predict::Prediction;
 use chatter_bayes::prior::erfc;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -66,8 +67,8 @@ pub(crate) fn predictive_check(
             let q: Vec<f64> = data
                 .cuts
                 .iter()
-                .zip(&pred.cut_limit_m)
-                .map(|(c, b)| noise.chatter_probability((c.depth_m / b).ln()))
+                .zip(&pred.cuts)
+                .map(|(_, q)| noise.chatter_probability(q.map_or(f64::NAN, |q| q.log_distance())))
                 .collect();
             let deviance = |unstable: &dyn Fn(usize) -> bool| -> f64 {
                 q.iter()
@@ -94,13 +95,9 @@ pub(crate) fn predictive_check(
             .enumerate()
             .filter_map(|(i, c)| {
                 let f = c.chatter_hz?;
-                let lobes = &pred.cut_lobes[i];
-                lobes
-                    .lobes()
-                    .filter(|(b, _)| *b <= c.depth_m.max(lobes.depth_m))
-                    .map(|(_, fc)| folded(f - fc, pred.cut_fold_hz[i]).abs())
-                    .min_by(f64::total_cmp)
-                    .map(|r| (r / data.chatter_std_hz).powi(2))
+                let q = pred.cuts[i]?;
+                let r = chatter_residual(f, q.chatter_hz, pred.cut_fold_hz[i]);
+                Some((r / data.chatter_std_hz).powi(2))
             })
             .collect();
         if !chatter.is_empty() {
@@ -109,21 +106,21 @@ pub(crate) fn predictive_check(
         if !data.poles.is_empty() {
             let (mut tf, mut tz) = (0.0, 0.0);
             for (i, p) in data.poles.iter().enumerate() {
-                match matched_pole(
-                    p.frequency_hz,
-                    p.damping_ratio,
-                    p.frequency_std_hz,
-                    p.damping_std,
-                    &pred.poles[i],
-                    pred.pole_fold_hz[i],
-                ) {
-                    Some((rf, rz)) => {
+                match pred.poles[i] {
+                    Some(q) => {
+                        let (rf, rz) = pole_residuals(
+                            p.frequency_hz,
+                            p.damping_ratio,
+                            &q,
+                            pred.pole_fold_hz[i],
+                        );
                         tf += (rf / p.frequency_std_hz).powi(2);
                         tz += (rz / p.damping_std).powi(2);
                     }
+                    // a failed prediction is neither a misfit nor a fit
                     None => {
-                        tf += 100.0;
-                        tz += 100.0;
+                        tf += 1.0;
+                        tz += 1.0;
                     }
                 }
             }

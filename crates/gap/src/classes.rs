@@ -2,8 +2,10 @@
 //!
 //! Every class recalibrates the nominal model with three factors (sampled as logarithms):
 //! all natural frequencies by s_f at constant modal stiffness, all damping ratios by s_zeta, and
-//! the cutting coefficients over the stiffness by g (the zero-order boundary and the poles
-//! depend on the cutting coefficients and the stiffness only through this ratio). The classes add:
+//! the cutting coefficients over the stiffness by g (the delay equation depends on the cutting
+//! coefficients and the stiffness only through this ratio, so g scales the cutting
+//! coefficients). Each sample becomes a [`Variant`] evaluated exactly ([`crate::predict`]).
+//! The classes add:
 //!
 //! | class | extra parameters | prior |
 //! |---|---|---|
@@ -18,9 +20,11 @@
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::machine::{FastMode, Machine, geometries, quadratic};
+use crate::variant::{Variant, recalibrated};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
-use chatter_dynamics::ModalModel;
+use chatter_dynamics::{ModalModel, Mode, ModeShape};
+use chatter_stability::process_damping::{average_normal_projector, damping_ratio_slope_per_m};
+use chatter_stability::zero_order::zoa_limiting_depth;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -85,10 +89,11 @@ impl std::str::FromStr for EffectClass {
     }
 }
 
-/// The nominal model in fast form with the references the priors are scaled by.
+/// The nominal model with the references the priors are scaled by.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Nominal {
-    pub machine: Machine,
+    /// The nominal model as given.
+    pub model: ModalModel,
     /// Natural frequency of the dominant mode (Hz).
     pub reference_hz: f64,
     /// Modal stiffness of the dominant mode, omega^2 / |phi|^2 (N/m).
@@ -100,43 +105,47 @@ pub(crate) struct Nominal {
 }
 
 impl Nominal {
-    /// The nominal model with the geometries of `immersions`; `speeds` are the observed speeds
-    /// (rpm) that scale the priors.
-    pub fn new(model: &ModalModel, immersions: &[Option<f64>], speeds: &[f64]) -> Result<Self> {
-        let machine = Machine::from_model(model, geometries(model, immersions)?)?;
-        let a = machine.geometries[0].directional;
-        let dominant = machine
-            .modes
+    /// The nominal model; `speeds` are the observed speeds (rpm) that scale the priors.
+    pub fn new(model: &ModalModel, speeds: &[f64]) -> Result<Self> {
+        let a = model.average_directional_matrix();
+        let a = [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]];
+        let dominant = model
+            .modes()
             .iter()
-            .copied()
             .max_by(|x, y| weight(x, &a).total_cmp(&weight(y, &a)))
             .ok_or_else(|| GapError::Model("no modes".into()))?;
-        let reference_hz = dominant.omega / (2.0 * PI);
-        let phi2 = dominant.phi[0].powi(2) + dominant.phi[1].powi(2);
-        let reference_stiffness_n_per_m = dominant.omega.powi(2) / phi2;
+        let reference_hz = dominant.frequency_hz();
+        let phi = dominant.mass_normalized_shape();
+        let reference_stiffness_n_per_m =
+            dominant.omega_rad_s().powi(2) / (phi[0].powi(2) + phi[1].powi(2));
         let max_speed_rpm = speeds.iter().copied().fold(0.0, f64::max);
         let min_speed_rpm = speeds.iter().copied().fold(f64::INFINITY, f64::min);
         if !(max_speed_rpm > 0.0 && min_speed_rpm.is_finite()) {
             return Err(GapError::Observations("no spindle speeds".into()));
         }
-        let process_damping_scale_n_per_m = match machine.diameter_m {
+        let process_damping_scale_n_per_m = match model.operation().cutting_diameter_m() {
             Some(d) => {
-                let mut bare = machine.clone();
-                bare.process_damping_n_per_m = 0.0;
-                let requests: Vec<(f64, usize)> = speeds.iter().map(|&s| (s, 0)).collect();
-                let b_min = bare
-                    .boundary(&requests)
+                // the lowest zero-order limit over the observed speeds (a prior scale only)
+                let bare = model.with_process_damping(None)?;
+                let b_min = speeds
                     .iter()
+                    .filter_map(|&s| zoa_limiting_depth(&bare, s).ok())
                     .map(|p| p.depth_m)
                     .fold(f64::INFINITY, f64::min);
                 // the mode process damping acts on most, relative to its own damping
                 let v = PI * d * min_speed_rpm / 60.0;
-                let c = machine
-                    .modes
+                let projector = average_normal_projector(model.operation());
+                let c = model
+                    .modes()
                     .iter()
                     .map(|m| {
-                        let q = quadratic(&machine.geometries[0].damping_per_cv, m.phi);
-                        PROCESS_DAMPING_SPAN * m.zeta * 2.0 * m.omega * v / (b_min * q)
+                        // damping-ratio slope per m of depth at C / V = 1
+                        let q = damping_ratio_slope_per_m(
+                            m.mass_normalized_shape(),
+                            m.omega_rad_s(),
+                            &projector,
+                        );
+                        PROCESS_DAMPING_SPAN * m.damping_ratio() * v / (b_min * q)
                     })
                     .fold(f64::INFINITY, f64::min);
                 (c.is_finite() && c > 0.0).then_some(c)
@@ -144,7 +153,7 @@ impl Nominal {
             None => None,
         };
         Ok(Self {
-            machine,
+            model: model.clone(),
             reference_hz,
             reference_stiffness_n_per_m,
             max_speed_rpm,
@@ -153,9 +162,18 @@ impl Nominal {
     }
 }
 
+impl Nominal {
+    /// The nominal model as a variant.
+    pub fn variant(&self) -> Variant {
+        Variant::new(self.model.clone())
+    }
+}
+
 /// Oriented modal weight phi^T A phi / (zeta omega^2) of a mode (its share of chatter).
-fn weight(m: &FastMode, a: &[[f64; 2]; 2]) -> f64 {
-    quadratic(a, m.phi) / (m.zeta.max(1e-6) * m.omega * m.omega)
+fn weight(m: &Mode, a: &[[f64; 2]; 2]) -> f64 {
+    let p = m.mass_normalized_shape();
+    let q = p[0] * (a[0][0] * p[0] + a[0][1] * p[1]) + p[1] * (a[1][0] * p[0] + a[1][1] * p[1]);
+    q / (m.damping_ratio().max(1e-6) * m.omega_rad_s().powi(2))
 }
 
 /// A class ready for the sampler: prior and the map from parameters to a machine.
@@ -239,41 +257,40 @@ impl<'a> ClassModel<'a> {
         })
     }
 
-    /// The machine at parameters `theta`; None where they make no physical model.
-    pub fn machine(&self, theta: &[f64]) -> Option<Machine> {
-        let mut m = self.nominal.machine.clone();
+    /// The variant at parameters `theta`; None where they make no physical model.
+    pub fn variant(&self, theta: &[f64]) -> Option<Variant> {
         let (sf, sz, g) = (theta[0].exp(), theta[1].exp(), theta[2].exp());
-        for mode in &mut m.modes {
-            mode.omega *= sf;
-            mode.phi = [mode.phi[0] * sf, mode.phi[1] * sf];
-            mode.zeta *= sz;
-            if mode.zeta >= 1.0 {
-                return None;
-            }
-        }
-        m.gain = g;
+        let model = recalibrated(&self.nominal.model, sf, sz, g).ok()?;
+        let mut v = Variant::new(model);
         match self.class {
             EffectClass::ParameterError => {}
             EffectClass::ProcessDamping => {
-                m.process_damping_n_per_m =
-                    theta[3] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0);
+                let c = theta[3] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0);
+                v.model = v.model.with_process_damping((c > 0.0).then_some(c)).ok()?;
             }
             EffectClass::SpeedDependentDynamics => {
-                m.softening_per_rpm2 = theta[3] / self.nominal.max_speed_rpm.powi(2);
+                v.softening_per_rpm2 = theta[3] / self.nominal.max_speed_rpm.powi(2);
             }
             EffectClass::ExtraMode => {
-                let omega = 2.0 * PI * self.nominal.reference_hz * theta[3].exp();
+                let f = self.nominal.reference_hz * theta[3].exp();
                 let k = self.nominal.reference_stiffness_n_per_m * theta[5].exp();
-                let amplitude = omega / k.sqrt();
-                m.modes.push(FastMode {
-                    omega,
-                    zeta: theta[4].exp(),
-                    phi: [amplitude * theta[6].cos(), amplitude * theta[6].sin()],
-                });
+                let amplitude = 2.0 * PI * f / k.sqrt();
+                let mode = Mode::new(
+                    f,
+                    theta[4].exp(),
+                    ModeShape::MassNormalized([
+                        amplitude * theta[6].cos(),
+                        amplitude * theta[6].sin(),
+                    ]),
+                )
+                .ok()?;
+                let mut modes = v.model.modes().to_vec();
+                modes.push(mode);
+                v.model = v.model.with_modes(modes).ok()?;
             }
-            EffectClass::Drift => m.drift_rate = theta[3],
+            EffectClass::Drift => v.drift_rate = theta[3],
         }
-        Some(m)
+        Some(v)
     }
 
     /// Reported parameters at `theta`: names with units and values.

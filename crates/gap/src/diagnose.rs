@@ -4,18 +4,22 @@ use crate::check::{PredictiveCheck, predictive_check};
 use crate::classes::{ClassModel, EffectClass, Nominal, unavailable};
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::likelihood::{NoiseModel, Prediction, predict, terms};
-use crate::machine::Machine;
+use crate::likelihood::{NoiseModel, terms};
+use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
 use crate::shrink::{Shrink, ValidationReport, shrink};
+use crate::variant::Variant;
 use chatter_bayes::Prior;
 use chatter_bayes::tmcmc::{
-    Silent, TmcmcOptions, TmcmcResult, Variant, class_probabilities, tmcmc,
+    Silent, TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, tmcmc,
 };
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
+use chatter_stability::monodromy::Discretization;
 use rayon::prelude::*;
 use serde::{Serialize, Serializer};
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Posterior samples used by the predictive check and the posterior predictive densities.
 pub(crate) const PREDICTIVE_SAMPLES: usize = 100;
@@ -48,20 +52,22 @@ pub struct DiagnoseOptions {
 }
 
 impl Default for DiagnoseOptions {
-    /// Seed 0, 250 samples, 2 steps after 1 burn-in step, the default noise, level 0.01, an
+    /// Seed 0, 120 samples, 1 step after 1 burn-in step (every likelihood is a full
+    /// discretization per observation, so the sampler budget is kept small: a 40-cut, 8-pole
+    /// campaign takes about 20 s per class on two cores), the default noise, level 0.01, an
     /// effect named from a Bayes factor of 3 over recalibration ("positive" evidence, Kass and
-    /// Raftery), 5-fold validation with 150 samples, every class.
+    /// Raftery), 3-fold validation with 80 samples, every class.
     fn default() -> Self {
         Self {
             seed: 0,
-            samples: 250,
-            steps: 2,
+            samples: 120,
+            steps: 1,
             burn_in: 1,
             noise: NoiseModel::default(),
             check_level: 0.01,
             min_log_bayes_factor: 3f64.ln(),
-            validation: Validation::KFold { folds: 5 },
-            validation_samples: 150,
+            validation: Validation::KFold { folds: 3 },
+            validation_samples: 80,
             classes: EffectClass::ALL.to_vec(),
         }
     }
@@ -76,8 +82,8 @@ impl DiagnoseOptions {
                 expected,
             })
         };
-        if self.samples < 50 {
-            return bad("samples", self.samples as f64, ">= 50 samples per class");
+        if self.samples < 40 {
+            return bad("samples", self.samples as f64, ">= 40 samples per class");
         }
         if self.steps == 0 {
             return bad("steps", 0.0, ">= 1 step");
@@ -98,11 +104,11 @@ impl DiagnoseOptions {
             }
             _ => {}
         }
-        if self.validation != Validation::Off && self.validation_samples < 50 {
+        if self.validation != Validation::Off && self.validation_samples < 40 {
             return bad(
                 "validation_samples",
                 self.validation_samples as f64,
-                ">= 50 samples",
+                ">= 40 samples",
             );
         }
         let mut out = self.clone();
@@ -120,7 +126,7 @@ impl DiagnoseOptions {
             samples,
             steps: self.steps,
             burn_in: self.burn_in,
-            variant: Variant::Improved,
+            variant: Sampler::Improved,
             seed,
             ..TmcmcOptions::default()
         }
@@ -157,9 +163,12 @@ pub trait DiagnosisObserver: Sync {
 pub struct Quiet;
 impl DiagnosisObserver for Quiet {}
 
-/// The verdict: the class that explains the gap, or none of them.
+/// The verdict: the nominal model explains the data, a class explains the gap, or none does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
+    /// The nominal model explains the data up to the noise: it passes the predictive check and
+    /// no class beats it by the required Bayes factor.
+    Consistent,
     /// The best class passes the predictive check.
     Class(EffectClass),
     /// The best class still leaves residuals inconsistent with the noise.
@@ -170,6 +179,7 @@ impl Verdict {
     /// `parameter_error`, ..., or `unexplained`.
     pub fn name(self) -> &'static str {
         match self {
+            Verdict::Consistent => "consistent",
             Verdict::Class(c) => c.name(),
             Verdict::Unexplained => "unexplained",
         }
@@ -206,12 +216,45 @@ pub struct ClassReport {
     pub information_gain: f64,
     /// Posterior summaries of the physical parameters.
     pub parameters: BTreeMap<String, ParameterSummary>,
+    /// Multiplier evaluations inside the sampler.
+    pub evaluations: usize,
+    /// Of those, solver failures (each given a neutral likelihood term, never read as stable).
+    pub solver_failures: usize,
+    /// Whether failures exceed 1 % of the evaluations: the class's evidence is then unreliable.
+    pub failures_flagged: bool,
 }
 
-/// A fitted class: the sampler's result and the map to machines.
+/// Share of failed evaluations above which a class is flagged.
+pub const MAX_FAILURE_RATE: f64 = 0.01;
+
+/// Counts of multiplier evaluations and solver failures, shared by the sampler's threads.
+#[derive(Debug, Default)]
+pub(crate) struct FailureCount {
+    evaluations: AtomicUsize,
+    failures: AtomicUsize,
+}
+
+impl FailureCount {
+    fn add(&self, p: &Prediction) {
+        self.evaluations
+            .fetch_add(p.evaluations(), Ordering::Relaxed);
+        self.failures.fetch_add(p.failures, Ordering::Relaxed);
+    }
+    fn get(&self) -> (usize, usize) {
+        (
+            self.evaluations.load(Ordering::Relaxed),
+            self.failures.load(Ordering::Relaxed),
+        )
+    }
+}
+
+/// A fitted class: the sampler's result and the map to variants.
 pub(crate) struct Fitted<'a> {
     pub model: ClassModel<'a>,
     pub run: TmcmcResult,
+    /// Multiplier evaluations and solver failures inside the sampler.
+    pub evaluations: usize,
+    pub failures: usize,
 }
 
 impl Fitted<'_> {
@@ -222,29 +265,37 @@ impl Fitted<'_> {
         s.iter().step_by(step).take(n).map(Vec::as_slice).collect()
     }
 
-    /// The highest-posterior sample's machine.
-    pub fn mode_machine(&self) -> Option<Machine> {
+    /// The highest-posterior sample's variant.
+    pub fn mode_variant(&self) -> Option<Variant> {
         let s = self.run.samples.samples();
         let best = s
             .iter()
             .zip(&self.run.ln_likelihoods)
             .map(|(t, l)| (t, l + self.model.prior.ln_pdf(t)))
             .max_by(|a, b| a.1.total_cmp(&b.1))?;
-        self.model.machine(best.0)
+        self.model.variant(best.0)
     }
 }
 
-/// The log-likelihood of `data` for a class at `theta`.
+/// The log-likelihood of `data` for a class at `theta`: -inf only outside the physical support
+/// (no valid model); solver failures give neutral terms and are counted in `count`.
 pub(crate) fn log_likelihood(
     model: &ClassModel,
     data: &Dataset,
     noise: &NoiseModel,
     theta: &[f64],
+    count: &FailureCount,
 ) -> f64 {
-    match model.machine(theta) {
-        Some(m) => {
-            let v = terms(&predict(&m, data), data, noise).total();
-            if v.is_nan() { f64::NEG_INFINITY } else { v }
+    match model.variant(theta) {
+        Some(v) => {
+            let prediction = predict(&v, data);
+            count.add(&prediction);
+            let total = terms(&prediction, data, noise).total();
+            if total.is_nan() {
+                f64::NEG_INFINITY
+            } else {
+                total
+            }
         }
         None => f64::NEG_INFINITY,
     }
@@ -260,7 +311,8 @@ pub(crate) fn fit<'a>(
     seed: u64,
 ) -> Result<Fitted<'a>> {
     let model = ClassModel::new(class, nominal)?;
-    let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta);
+    let count = FailureCount::default();
+    let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta, &count);
     let run =
         tmcmc(&model.prior, &like, &options.tmcmc(samples, seed), &Silent).map_err(|source| {
             GapError::Sampler {
@@ -268,7 +320,13 @@ pub(crate) fn fit<'a>(
                 source,
             }
         })?;
-    Ok(Fitted { model, run })
+    let (evaluations, failures) = count.get();
+    Ok(Fitted {
+        model,
+        run,
+        evaluations,
+        failures,
+    })
 }
 
 /// Predictions of the thinned posterior samples.
@@ -276,7 +334,7 @@ pub(crate) fn posterior_predictions(fitted: &Fitted, data: &Dataset) -> Vec<Pred
     fitted
         .thinned(PREDICTIVE_SAMPLES)
         .par_iter()
-        .filter_map(|t| fitted.model.machine(t).map(|m| predict(&m, data)))
+        .filter_map(|t| fitted.model.variant(t).map(|m| predict(&m, data)))
         .collect()
 }
 
@@ -312,9 +370,8 @@ pub(crate) fn prepare(
                 .into(),
         ));
     }
-    let reference = Nominal::new(model, &[None], &speeds)?.reference_hz;
-    let data = Dataset::new(model, observations, noise, reference)?;
-    let nominal = Nominal::new(model, &data.immersions, &speeds)?;
+    let nominal = Nominal::new(model, &speeds)?;
+    let data = Dataset::new(model, observations, noise, nominal.reference_hz)?;
     Ok(Prepared { nominal, data })
 }
 
@@ -342,10 +399,15 @@ pub struct Diagnosis {
     pub residuals: ResidualPair,
     /// Why classes were left out, and what in the observations was not used.
     pub notes: Vec<String>,
+    /// ln p(D | nominal model): the likelihood of the nominal model, a class without free
+    /// parameters.
+    pub nominal_log_evidence: f64,
+    /// The predictive check of the nominal model itself (the `consistent` verdict needs it).
+    pub nominal_check: PredictiveCheck,
     #[serde(skip)]
-    pub(crate) nominal: Machine,
+    pub(crate) nominal: Variant,
     #[serde(skip)]
-    pub(crate) diagnosed: Machine,
+    pub(crate) diagnosed: Variant,
 }
 
 /// Residuals against the nominal model and against the diagnosed one (the best class at its
@@ -370,22 +432,49 @@ pub struct LobeComparison {
 }
 
 impl Diagnosis {
-    /// Limiting depths of the nominal and the diagnosed model at `speeds_rpm` (zero-order,
-    /// the model's own radial immersion).
+    /// Limiting depths of the nominal and the diagnosed model at `speeds_rpm` (full
+    /// discretization, the model's own radial immersion; the diagnosed model at the end of the
+    /// campaign for drift). A speed whose solver fails gives NaN.
     pub fn lobes(&self, speeds_rpm: &[f64]) -> Vec<LobeComparison> {
-        let requests: Vec<(f64, usize)> = speeds_rpm.iter().map(|&s| (s, 0)).collect();
-        let nominal = self.nominal.boundary(&requests);
-        let diagnosed = self.diagnosed.boundary(&requests);
-        let end = self.diagnosed.drift_factor(1.0);
+        let depth = |v: &Variant, speed: f64, u: f64| -> f64 {
+            v.at(None, speed, u)
+                .ok()
+                .and_then(|m| {
+                    limiting_depth(
+                        &Discretization::full(),
+                        &m,
+                        speed,
+                        &BoundaryOptions::default(),
+                    )
+                    .ok()
+                })
+                .map_or(f64::NAN, |p| p.depth_m * 1e3)
+        };
         speeds_rpm
-            .iter()
-            .zip(nominal.iter().zip(&diagnosed))
-            .map(|(&speed_rpm, (n, d))| LobeComparison {
+            .par_iter()
+            .map(|&speed_rpm| LobeComparison {
                 speed_rpm,
-                nominal_mm: n.depth_m * 1e3,
-                diagnosed_mm: d.scaled_depth(end).depth_m * 1e3,
+                nominal_mm: depth(&self.nominal, speed_rpm, 0.0),
+                diagnosed_mm: depth(&self.diagnosed, speed_rpm, 1.0),
             })
             .collect()
+    }
+
+    /// The diagnosed machine: the verdict's class at its highest-posterior sample (the
+    /// nominal model for `consistent`), as a model file at campaign start and zero speed.
+    pub fn diagnosed_model(&self) -> &ModalModel {
+        &self.diagnosed.model
+    }
+
+    /// The diagnosed machine with its speed- and time-dependent effects.
+    pub fn diagnosed_variant(&self) -> &Variant {
+        &self.diagnosed
+    }
+
+    /// Effects of the diagnosed machine that a model file does not hold: the speed softening
+    /// c in f_n (1 - c Omega^2) (1/rpm^2) and the drift r in cutting x (1 + r u).
+    pub fn diagnosed_effects(&self) -> (f64, f64) {
+        (self.diagnosed.softening_per_rpm2, self.diagnosed.drift_rate)
     }
 }
 
@@ -445,7 +534,22 @@ pub fn diagnose(
         options.seed,
     );
     let best_class = fitted[best].model.class;
-    let verdict = if check.passed {
+    // the nominal model is a class without parameters: its evidence is its likelihood
+    let nominal_variant = nominal.variant();
+    let nominal_prediction = predict(&nominal_variant, &data);
+    let nominal_log_evidence = terms(&nominal_prediction, &data, &options.noise).total();
+    let nominal_check = predictive_check(
+        std::slice::from_ref(&nominal_prediction),
+        &data,
+        &options.noise,
+        options.check_level,
+        options.seed,
+    );
+    let consistent = nominal_check.passed
+        && evidences[most_probable] - nominal_log_evidence < options.min_log_bayes_factor;
+    let verdict = if consistent {
+        Verdict::Consistent
+    } else if check.passed {
         Verdict::Class(best_class)
     } else {
         Verdict::Unexplained
@@ -460,25 +564,36 @@ pub fn diagnose(
             data_fit: f.run.data_fit(),
             information_gain: f.run.information_gain(),
             parameters: summaries(f),
+            evaluations: f.evaluations,
+            solver_failures: f.failures,
+            failures_flagged: f.failures as f64 > MAX_FAILURE_RATE * f.evaluations.max(1) as f64,
         })
         .collect();
-    let diagnosed = fitted[best]
-        .mode_machine()
-        .unwrap_or_else(|| nominal.machine.clone());
-    let nominal_prediction = predict(&nominal.machine, &data);
+    let diagnosed = if consistent {
+        nominal_variant.clone()
+    } else {
+        fitted[best]
+            .mode_variant()
+            .unwrap_or_else(|| nominal_variant.clone())
+    };
     let residual_pair = ResidualPair {
         nominal: residuals(&nominal_prediction, &data, &options.noise),
         diagnosed: residuals(&predict(&diagnosed, &data), &data, &options.noise),
     };
     let context = RegionContext {
-        min_limit_mm: nominal_prediction
-            .cut_limit_m
+        min_limit_mm: residual_pair
+            .nominal
+            .cuts
             .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min)
-            * 1e3,
-        cut_diameter_m: nominal.machine.diameter_m,
-        cut_chatter_hz: nominal_prediction.cut_chatter_hz.clone(),
+            .map(|c| c.limit_mm)
+            .filter(|b| b.is_finite())
+            .fold(f64::INFINITY, f64::min),
+        cut_diameter_m: model.operation().cutting_diameter_m(),
+        cut_chatter_hz: nominal_prediction
+            .cuts
+            .iter()
+            .map(|c| c.map_or(f64::NAN, |q| q.chatter_hz))
+            .collect(),
     };
     let regions = regions(&residual_pair.nominal, &context);
     let (shrink, validation) = match shrink(best_class, &nominal, &data, &options, observer)? {
@@ -495,7 +610,9 @@ pub fn diagnose(
         validation,
         residuals: residual_pair,
         notes,
-        nominal: nominal.machine.clone(),
+        nominal_log_evidence,
+        nominal_check,
+        nominal: nominal_variant,
         diagnosed,
     })
 }

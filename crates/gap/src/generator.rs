@@ -1,44 +1,57 @@
-//! Synthetic shop-floor data from a "true" machine that hides one effect: the proving ground of
-//! the diagnosis (and the data of `chatter demo`).
+//! The proving ground: synthetic shop-floor campaigns from a "true" machine that hides one
+//! effect, computed by a different and more faithful solver than the one inside the diagnosis.
 //!
-//! The true machine is the nominal model with a recalibration error (frequencies, damping,
-//! cutting coefficients over stiffness) and one hidden effect: process damping, speed-dependent
-//! modes, an extra mode, drift of the cutting coefficients over the campaign, or an effect outside
-//! the candidate list, runout so strong that only some teeth cut (the delay becomes several
-//! tooth periods and the force average drops). Its boundary is the fast zero-order form at four
-//! times the inference grid density.
+//! # Truth
+//! The true machine is a [`Variant`] of the nominal model (a recalibration error and one hidden
+//! effect). Every true quantity comes from the **semi-discretization** (Insperger and Stépán)
+//! at four times the automatic resolution of the true model (at least 160 steps per delay),
+//! while the diagnosis uses the first-order **full discretization** at the automatic
+//! resolution: another scheme at a converged resolution, so the inference's discretization
+//! error shows in the data as it would against a real machine. `tests/proving_ground.rs`
+//! checks the truth against an independent computation written in the test.
 //!
-//! The campaign is a designed experiment: at every test speed, depths at fixed ratios of the
-//! nominal limiting depth, run in random order (`sequence`). A cut chatters with probability
-//! Phi(ln(b / b_true) / w) (label noise near the boundary); a chattering cut reports the true
-//! chatter frequency plus Gaussian jitter. Poles are the exact dominant poles of the true
-//! machine at stable depths (fractions of the true limit) plus Gaussian noise with the
-//! standard deviations written to the file, as repeated operational modal analysis would give.
+//! # Campaign
+//! As a shop would run it: `cuts` cuts at `speeds` test speeds drawn uniformly over the
+//! machine's range and depths log-uniform between 0.5 and 2 times the **nominal** limiting depth
+//! there, in random order (`sequence`). A cut is labelled chatter when |mu| > 1 at its depth
+//! jittered by exp(w e), e ~ N(0, 1): a probit in ln(b / b_lim) with width w (label noise near
+//! the boundary). A chattering cut reports the frequency of the dominant multiplier at its own
+//! depth with relative jitter. Poles are the dominant closed-loop poles of stable cuts (fractions
+//! of the true limit at the pole speeds), lifted for milling, with relative frequency and
+//! damping noise, as repeated operational modal analysis would give.
 //!
-//! ```
+//! ```no_run
 //! use chatter_gap::{HiddenEffect, Scenario, nominal_milling, synthesize};
 //! let nominal = nominal_milling()?;
 //! let scenario = Scenario::new(HiddenEffect::Drift { cutting_change_over_campaign: 0.5 }, 7);
 //! let data = synthesize(&nominal, &scenario)?;
-//! assert_eq!(data.cuts.len(), 18 * 7);
-//! assert_eq!(data.poles.len(), 8);
+//! assert_eq!(data.cuts.len(), scenario.cuts);
 //! assert!(data.cuts.iter().all(|c| c.sequence.is_some()));
 //! # Ok::<(), chatter_gap::GapError>(())
 //! ```
 
 use crate::classes::EffectClass;
 use crate::error::{GapError, Result, positive};
-use crate::machine::{FastMode, Machine, geometries};
+use crate::predict::observed_pole;
+use crate::variant::{CuttingBand, Variant, recalibrated};
 use chatter_dynamics::{
     Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Observations,
-    Operation, PoleObservation,
+    Operation, PoleObservation, Turning,
 };
+use chatter_stability::StabilitySolver;
+use chatter_stability::boundary::{BoundaryOptions, dominant_mode_frequency_hz, limiting_depth};
+use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use num_complex::Complex64;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
-use rand_distr::{Distribution, Normal};
+use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
 use std::f64::consts::PI;
+
+/// Resolution of the truth relative to the automatic one, and its floor.
+const TRUTH_REFINEMENT: usize = 4;
+const TRUTH_MIN_STEPS: usize = 160;
 
 /// The effect hidden in the true machine.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -78,10 +91,21 @@ pub enum HiddenEffect {
         /// Teeth that cut (a divisor of the cutter's teeth).
         cutting_teeth: usize,
     },
+    /// Outside the candidate list: the cutting coefficients change by a factor inside a band of
+    /// speeds (e.g. built-up edge).
+    CuttingBand {
+        /// Lowest speed of the band (rpm).
+        from_rpm: f64,
+        /// Highest speed of the band (rpm).
+        to_rpm: f64,
+        /// Factor on the cutting coefficients.
+        factor: f64,
+    },
 }
 
 impl HiddenEffect {
-    /// The class a correct diagnosis names, or None for an effect outside the list.
+    /// The class a correct diagnosis names (`None` for `consistent` or an effect outside the
+    /// list).
     pub fn expected_class(&self) -> Option<EffectClass> {
         match self {
             HiddenEffect::ParameterError => Some(EffectClass::ParameterError),
@@ -91,14 +115,19 @@ impl HiddenEffect {
             }
             HiddenEffect::ExtraMode { .. } => Some(EffectClass::ExtraMode),
             HiddenEffect::Drift { .. } => Some(EffectClass::Drift),
-            HiddenEffect::Runout { .. } => None,
+            HiddenEffect::Runout { .. } | HiddenEffect::CuttingBand { .. } => None,
         }
     }
 
-    /// The expected verdict's name (`unexplained` outside the list).
-    pub fn expected_verdict(&self) -> &'static str {
-        self.expected_class()
-            .map_or("unexplained", EffectClass::name)
+    /// The expected verdict's name for a true machine with recalibration `error`: `consistent`
+    /// when there is neither an effect nor an error, `unexplained` outside the list.
+    pub fn expected_verdict(&self, error: &Recalibration) -> &'static str {
+        match self {
+            HiddenEffect::ParameterError if *error == Recalibration::default() => "consistent",
+            _ => self
+                .expected_class()
+                .map_or("unexplained", EffectClass::name),
+        }
     }
 }
 
@@ -141,56 +170,62 @@ pub struct Scenario {
     pub effect: HiddenEffect,
     /// The recalibration error.
     pub error: Recalibration,
-    /// Test speeds (rpm).
-    pub speeds_rpm: Vec<f64>,
-    /// Depths of every test speed as multiples of the nominal limiting depth there.
-    pub depth_ratios: Vec<f64>,
-    /// Speeds at which poles are identified (rpm).
+    /// Speed range of the cuts (rpm).
+    pub speed_range_rpm: (f64, f64),
+    /// Number of test cuts.
+    pub cuts: usize,
+    /// Number of distinct test speeds the cuts share (drawn uniformly over the range).
+    pub speeds: usize,
+    /// Range of the cut depths as multiples of the nominal limiting depth (log-uniform).
+    pub depth_ratio_range: (f64, f64),
+    /// Speeds at which poles are identified (rpm); two poles each.
     pub pole_speeds_rpm: Vec<f64>,
     /// Depths of the pole cuts as fractions of the true limiting depth.
     pub pole_depth_fractions: Vec<f64>,
     /// Probit width of the label noise in ln depth.
     pub label_width_log_depth: f64,
-    /// Standard deviation of the chatter-frequency jitter (Hz).
-    pub chatter_jitter_hz: f64,
-    /// Standard deviation of identified pole frequencies (Hz).
-    pub pole_frequency_std_hz: f64,
-    /// Standard deviation of identified pole damping ratios, relative.
+    /// Relative standard deviation of the chatter-frequency jitter.
+    pub chatter_jitter_relative: f64,
+    /// Relative standard deviation of identified pole frequencies.
+    pub pole_frequency_std_relative: f64,
+    /// Relative standard deviation of identified pole damping ratios.
     pub pole_damping_std_relative: f64,
     /// Whether `sequence` is recorded.
     pub run_order: RunOrder,
-    /// Seed of the run order and every noise draw.
+    /// Seed of the speeds, depths, run order and every noise draw.
     pub seed: u64,
 }
 
 impl Scenario {
-    /// A campaign with `effect` and the defaults: no recalibration error; 6 low speeds from 1200
-    /// to 3450 rpm and 12 from 4500 to 13000 rpm; depths 0.5 to 4 times the nominal limit in
-    /// steps of sqrt(2); poles at 2100, 6000, 9000 and 12000 rpm at 0.25 and 0.55 of the true
-    /// limit; label width 0.04; jitter 2 Hz; pole noise 1.5 Hz and 8 %; sequence recorded.
+    /// A campaign with `effect` on [`nominal_milling`] and the defaults: no recalibration error;
+    /// 32 cuts at 10 speeds between 2000 and 13000 rpm at 0.5-2 times the nominal limit; poles at 3000, 6000,
+    /// 9000 and 12000 rpm at 0.3 and 0.6 of the true limit; label width 0.05; chatter jitter
+    /// 0.3 %; pole noise 1 % in frequency and 20 % in damping; sequence recorded.
     pub fn new(effect: HiddenEffect, seed: u64) -> Self {
-        let low = (0..6).map(|i| 1200.0 + 450.0 * i as f64);
-        let high = (0..12).map(|i| 4500.0 + 8500.0 * i as f64 / 11.0);
         Self {
             effect,
             error: Recalibration::default(),
-            speeds_rpm: low.chain(high).collect(),
-            depth_ratios: (0..7).map(|i| 0.5 * 2f64.sqrt().powi(i)).collect(),
-            pole_speeds_rpm: vec![2100.0, 6000.0, 9000.0, 12000.0],
-            pole_depth_fractions: vec![0.25, 0.55],
-            label_width_log_depth: 0.04,
-            chatter_jitter_hz: 2.0,
-            pole_frequency_std_hz: 1.5,
-            pole_damping_std_relative: 0.08,
+            speed_range_rpm: (2000.0, 13000.0),
+            cuts: 32,
+            speeds: 10,
+            depth_ratio_range: (0.5, 2.0),
+            pole_speeds_rpm: vec![3000.0, 6000.0, 9000.0, 12000.0],
+            pole_depth_fractions: vec![0.3, 0.6],
+            label_width_log_depth: 0.05,
+            chatter_jitter_relative: 0.003,
+            pole_frequency_std_relative: 0.01,
+            pole_damping_std_relative: 0.2,
             run_order: RunOrder::Recorded,
             seed,
         }
     }
 
-    /// The same campaign without the speeds below `min_rpm` (tie-breaking data withheld).
-    pub fn without_speeds_below(mut self, min_rpm: f64) -> Self {
-        self.speeds_rpm.retain(|s| *s >= min_rpm);
-        self.pole_speeds_rpm.retain(|s| *s >= min_rpm);
+    /// The same campaign over another speed range, with the pole speeds spread over it.
+    pub fn with_speed_range(mut self, min_rpm: f64, max_rpm: f64, pole_speeds: usize) -> Self {
+        self.speed_range_rpm = (min_rpm, max_rpm);
+        self.pole_speeds_rpm = (0..pole_speeds)
+            .map(|i| min_rpm + (max_rpm - min_rpm) * (i as f64 + 0.5) / pole_speeds as f64)
+            .collect();
         self
     }
 }
@@ -200,16 +235,6 @@ impl Scenario {
 /// 3e6 N/m and a y mode of 810 Hz, 3.5 %, 3.6e6 N/m.
 pub fn nominal_milling() -> Result<ModalModel> {
     let op = Milling::new(4, 0.2, MillingDirection::Down, Some(0.01905), None)?;
-    let mode = |f: f64, z: f64, k: f64, coordinate: usize| {
-        Mode::new(
-            f,
-            z,
-            ModeShape::Directional {
-                coordinate,
-                stiffness_n_per_m: k,
-            },
-        )
-    };
     Ok(ModalModel::new(
         Some("synthetic shop: seed 001 cutter with two distinct modes".into()),
         Operation::Milling(op),
@@ -219,30 +244,133 @@ pub fn nominal_milling() -> Result<ModalModel> {
     )?)
 }
 
+fn mode(f: f64, z: f64, k: f64, coordinate: usize) -> Result<Mode> {
+    Ok(Mode::new(
+        f,
+        z,
+        ModeShape::Directional {
+            coordinate,
+            stiffness_n_per_m: k,
+        },
+    )?)
+}
+
+/// A mode of stiffness `k` along a direction `angle_deg` from the first coordinate.
+fn oblique(f: f64, z: f64, k: f64, angle_deg: f64) -> Result<Mode> {
+    let a = 2.0 * PI * f / k.sqrt();
+    let t = angle_deg.to_radians();
+    Ok(Mode::new(
+        f,
+        z,
+        ModeShape::MassNormalized([a * t.cos(), a * t.sin()]),
+    )?)
+}
+
+/// A machine of the proving ground: its nominal model and test speed range.
+#[derive(Debug, Clone)]
+pub struct ProvingMachine {
+    /// Short name.
+    pub name: &'static str,
+    /// The nominal model.
+    pub model: ModalModel,
+    /// Speed range of the campaigns (rpm).
+    pub speed_range_rpm: (f64, f64),
+}
+
+/// The machines of the proving ground: two-direction milling at 30 % (x 650 Hz, y 720 Hz,
+/// 4 teeth, down), low radial immersion (7 %, 2 teeth, up milling), two modes in one direction
+/// (3 teeth, 50 %), and turning (a feed mode and one at 30 degrees).
+pub fn proving_machines() -> Result<Vec<ProvingMachine>> {
+    let milling = |teeth, immersion, direction, modes: Vec<Mode>| -> Result<ModalModel> {
+        Ok(ModalModel::new(
+            None,
+            Operation::Milling(Milling::new(
+                teeth,
+                immersion,
+                direction,
+                Some(0.0127),
+                None,
+            )?),
+            CuttingCoefficients::new(700e6, 210e6)?,
+            modes,
+            None,
+        )?)
+    };
+    Ok(vec![
+        ProvingMachine {
+            name: "xy milling 30 %",
+            model: milling(
+                4,
+                0.3,
+                MillingDirection::Down,
+                vec![mode(650.0, 0.025, 8e6, 0)?, mode(720.0, 0.03, 1.1e7, 1)?],
+            )?,
+            speed_range_rpm: (3000.0, 12000.0),
+        },
+        ProvingMachine {
+            name: "low immersion 7 %",
+            model: milling(
+                2,
+                0.07,
+                MillingDirection::Up,
+                vec![mode(900.0, 0.02, 6e6, 0)?, mode(960.0, 0.025, 7e6, 1)?],
+            )?,
+            speed_range_rpm: (8000.0, 30000.0),
+        },
+        ProvingMachine {
+            name: "two modes in x",
+            model: milling(
+                3,
+                0.5,
+                MillingDirection::Down,
+                vec![mode(600.0, 0.03, 1.2e7, 0)?, mode(1100.0, 0.025, 1.5e7, 0)?],
+            )?,
+            speed_range_rpm: (4000.0, 16000.0),
+        },
+        ProvingMachine {
+            name: "turning",
+            model: ModalModel::new(
+                None,
+                Operation::Turning(Turning::new(Some(0.05))?),
+                CuttingCoefficients::new(1500e6, 600e6)?,
+                vec![
+                    mode(640.0, 0.03, 2.5e7, 0)?,
+                    oblique(700.0, 0.035, 3e7, 30.0)?,
+                ],
+                None,
+            )?,
+            speed_range_rpm: (800.0, 4000.0),
+        },
+    ])
+}
+
+/// The truth's solver for `model` at `speed_rpm` (see the module docs).
+pub fn truth_solver(model: &ModalModel, speed_rpm: f64) -> Result<Discretization> {
+    let auto = Discretization::semi()
+        .resolved(model, speed_rpm)
+        .map_err(|e| GapError::Model(e.to_string()))?;
+    let m = match auto.steps {
+        StepsPerDelay::Fixed(m) => m,
+        StepsPerDelay::Auto => TRUTH_MIN_STEPS,
+    };
+    Ok(Discretization::semi().with_steps((TRUTH_REFINEMENT * m).max(TRUTH_MIN_STEPS)))
+}
+
+/// The true limiting depth (m) of `model` at a speed; infinite where no lobe is below 1 m.
+pub fn true_limiting_depth(model: &ModalModel, speed_rpm: f64) -> Result<f64> {
+    let solver = truth_solver(model, speed_rpm)?;
+    let options = BoundaryOptions {
+        relative_tolerance: 1e-3,
+        start_depth_m: 1e-4,
+        ..BoundaryOptions::default()
+    };
+    limiting_depth(&solver, model, speed_rpm, &options)
+        .map(|p| p.depth_m)
+        .map_err(|e| GapError::Model(format!("true limiting depth at {speed_rpm} rpm: {e}")))
+}
+
 /// The true machine of `scenario` over `nominal`.
-fn true_machine(nominal: &ModalModel, scenario: &Scenario) -> Result<Machine> {
-    let mut model = nominal.clone();
-    if let HiddenEffect::Runout { cutting_teeth } = scenario.effect {
-        let Operation::Milling(op) = nominal.operation() else {
-            return Err(GapError::Model("runout needs a milling model".into()));
-        };
-        if cutting_teeth == 0 || op.teeth() % cutting_teeth != 0 {
-            return Err(GapError::InvalidInput {
-                field: "runout.cutting_teeth".into(),
-                value: cutting_teeth as f64,
-                expected: "a divisor of the cutter's teeth",
-            });
-        }
-        let fewer = Milling::new(
-            cutting_teeth,
-            op.radial_immersion(),
-            op.direction(),
-            op.tool_diameter_m(),
-            op.helix_rad(),
-        )?;
-        model = model.with_operation(Operation::Milling(fewer))?;
-    }
-    let mut m = Machine::from_model(&model, geometries(&model, &[None])?)?;
+pub fn true_variant(nominal: &ModalModel, scenario: &Scenario) -> Result<Variant> {
     let e = scenario.error;
     positive("error.frequency_factor", e.frequency_factor)?;
     positive("error.damping_factor", e.damping_factor)?;
@@ -250,29 +378,44 @@ fn true_machine(nominal: &ModalModel, scenario: &Scenario) -> Result<Machine> {
         "error.cutting_over_stiffness_factor",
         e.cutting_over_stiffness_factor,
     )?;
-    for mode in &mut m.modes {
-        mode.omega *= e.frequency_factor;
-        mode.phi = [
-            mode.phi[0] * e.frequency_factor,
-            mode.phi[1] * e.frequency_factor,
-        ];
-        mode.zeta *= e.damping_factor;
-    }
-    m.gain = e.cutting_over_stiffness_factor;
-    let max_speed = scenario.speeds_rpm.iter().copied().fold(0.0, f64::max);
+    let mut model = recalibrated(
+        nominal,
+        e.frequency_factor,
+        e.damping_factor,
+        e.cutting_over_stiffness_factor,
+    )?;
+    let mut v = Variant::new(model.clone());
     match scenario.effect {
-        HiddenEffect::ParameterError | HiddenEffect::Runout { .. } => {}
-        HiddenEffect::ProcessDamping { c_n_per_m } => {
-            if m.diameter_m.is_none() {
-                return Err(GapError::Model(
-                    "process damping needs the model's cutting diameter".into(),
-                ));
+        HiddenEffect::ParameterError => {}
+        HiddenEffect::Runout { cutting_teeth } => {
+            let Operation::Milling(op) = model.operation() else {
+                return Err(GapError::Model("runout needs a milling model".into()));
+            };
+            if cutting_teeth == 0 || op.teeth() % cutting_teeth != 0 {
+                return Err(GapError::InvalidInput {
+                    field: "runout.cutting_teeth".into(),
+                    value: cutting_teeth as f64,
+                    expected: "a divisor of the cutter's teeth",
+                });
             }
-            m.process_damping_n_per_m = c_n_per_m;
+            let fewer = Milling::new(
+                cutting_teeth,
+                op.radial_immersion(),
+                op.direction(),
+                op.tool_diameter_m(),
+                op.helix_rad(),
+            )?;
+            model = model.with_operation(Operation::Milling(fewer))?;
+            v.model = model;
+        }
+        HiddenEffect::ProcessDamping { c_n_per_m } => {
+            v.model = model.with_process_damping(Some(positive("c_n_per_m", c_n_per_m)?))?;
         }
         HiddenEffect::SpeedDependentDynamics {
             frequency_drop_at_max_speed,
-        } => m.softening_per_rpm2 = frequency_drop_at_max_speed / max_speed.powi(2),
+        } => {
+            v.softening_per_rpm2 = frequency_drop_at_max_speed / scenario.speed_range_rpm.1.powi(2);
+        }
         HiddenEffect::ExtraMode {
             frequency_hz,
             damping_ratio,
@@ -282,24 +425,113 @@ fn true_machine(nominal: &ModalModel, scenario: &Scenario) -> Result<Machine> {
             let omega = 2.0 * PI * positive("extra_mode.frequency_hz", frequency_hz)?;
             let a = omega / positive("extra_mode.stiffness_n_per_m", stiffness_n_per_m)?.sqrt();
             let angle = direction_deg.to_radians();
-            m.modes.push(FastMode {
-                omega,
-                zeta: damping_ratio,
-                phi: [a * angle.cos(), a * angle.sin()],
-            });
+            let mut modes = model.modes().to_vec();
+            modes.push(Mode::new(
+                frequency_hz,
+                damping_ratio,
+                ModeShape::MassNormalized([a * angle.cos(), a * angle.sin()]),
+            )?);
+            v.model = model.with_modes(modes)?;
         }
         HiddenEffect::Drift {
             cutting_change_over_campaign,
-        } => m.drift_rate = cutting_change_over_campaign,
+        } => v.drift_rate = cutting_change_over_campaign,
+        HiddenEffect::CuttingBand {
+            from_rpm,
+            to_rpm,
+            factor,
+        } => {
+            v.cutting_band = Some(CuttingBand {
+                from_rpm,
+                to_rpm,
+                factor: positive("cutting_band.factor", factor)?,
+            });
+        }
     }
-    if m.modes.iter().any(|x| !(x.zeta > 0.0 && x.zeta < 1.0)) {
-        return Err(GapError::InvalidInput {
-            field: "damping".into(),
-            value: m.modes.iter().map(|x| x.zeta).fold(0.0, f64::max),
-            expected: "true damping ratios in (0, 1)",
-        });
-    }
-    Ok(m)
+    Ok(v)
+}
+
+/// The effect of `class` at `magnitude` (1 = a clear but realistic gap) on `nominal` over
+/// `speed_range_rpm`, with its recalibration error: parameter error 1x = frequencies -3 %,
+/// damping +15 %, cutting over stiffness x1.36 (log factors scaled by the magnitude); process
+/// damping 1x = C adding the structural damping of the dominant mode at the lowest speed and
+/// the lowest nominal limit; speed-dependent dynamics 1x = 4 % frequency drop at the top speed;
+/// extra mode 1x = a 45-degree mode at 1.35 f_ref, 3 %, 1.5 k_ref (2x: k / 2, 0.5x: k x 2);
+/// drift 1x = +40 % over the campaign.
+pub fn effect_at(
+    class: EffectClass,
+    magnitude: f64,
+    nominal: &ModalModel,
+    speed_range_rpm: (f64, f64),
+) -> Result<(HiddenEffect, Recalibration)> {
+    let none = Recalibration::default();
+    let f_ref = dominant_mode_frequency_hz(nominal);
+    let dominant = nominal
+        .modes()
+        .iter()
+        .min_by(|a, b| {
+            (a.frequency_hz() - f_ref)
+                .abs()
+                .total_cmp(&(b.frequency_hz() - f_ref).abs())
+        })
+        .ok_or_else(|| GapError::Model("no modes".into()))?;
+    let phi = dominant.mass_normalized_shape();
+    let k_ref = dominant.omega_rad_s().powi(2) / (phi[0].powi(2) + phi[1].powi(2));
+    Ok(match class {
+        EffectClass::ParameterError => (
+            HiddenEffect::ParameterError,
+            Recalibration {
+                frequency_factor: 0.97f64.powf(magnitude),
+                damping_factor: 1.15f64.powf(magnitude),
+                cutting_over_stiffness_factor: 1.36f64.powf(magnitude),
+            },
+        ),
+        EffectClass::ProcessDamping => {
+            let d = nominal.operation().cutting_diameter_m().ok_or_else(|| {
+                GapError::Model("process damping needs the cutting diameter".into())
+            })?;
+            let b_min = (0..8)
+                .map(|i| {
+                    let s = speed_range_rpm.0
+                        + (speed_range_rpm.1 - speed_range_rpm.0) * i as f64 / 7.0;
+                    true_limiting_depth(nominal, s)
+                })
+                .collect::<Result<Vec<f64>>>()?
+                .into_iter()
+                .fold(f64::INFINITY, f64::min);
+            let v = PI * d * speed_range_rpm.0 / 60.0;
+            let projector =
+                chatter_stability::process_damping::average_normal_projector(nominal.operation());
+            let slope = chatter_stability::process_damping::damping_ratio_slope_per_m(
+                phi,
+                dominant.omega_rad_s(),
+                &projector,
+            );
+            let c = magnitude * dominant.damping_ratio() * v / (b_min * slope);
+            (HiddenEffect::ProcessDamping { c_n_per_m: c }, none)
+        }
+        EffectClass::SpeedDependentDynamics => (
+            HiddenEffect::SpeedDependentDynamics {
+                frequency_drop_at_max_speed: 0.04 * magnitude,
+            },
+            none,
+        ),
+        EffectClass::ExtraMode => (
+            HiddenEffect::ExtraMode {
+                frequency_hz: 1.35 * f_ref,
+                damping_ratio: 0.03,
+                stiffness_n_per_m: 1.5 * k_ref / magnitude,
+                direction_deg: 45.0,
+            },
+            none,
+        ),
+        EffectClass::Drift => (
+            HiddenEffect::Drift {
+                cutting_change_over_campaign: 0.4 * magnitude,
+            },
+            none,
+        ),
+    })
 }
 
 /// One entry of the run order: a test cut or a pole identification.
@@ -308,28 +540,51 @@ enum Entry {
     Pole { speed_rpm: f64, fraction: f64 },
 }
 
+/// ln|mu| and the frequency of the dominant multiplier of the truth at a cut, with the
+/// continuous-time pole lambda it implies (physical frequency).
+fn truth_at(model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<(f64, f64, Complex64)> {
+    let solver = truth_solver(model, speed_rpm)?;
+    let (mu, f) = solver
+        .chatter_frequency_hz(model, speed_rpm, depth_m)
+        .map_err(|e| GapError::Model(format!("truth at {speed_rpm} rpm, {depth_m} m: {e}")))?;
+    let lambda = Complex64::new(mu.modulus().ln() / mu.period_s, 2.0 * PI * f);
+    Ok((mu.modulus().ln(), f, lambda))
+}
+
 /// Synthetic observations of `scenario` on the machine whose nominal model is `nominal`.
 pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observations> {
-    let truth = true_machine(nominal, scenario)?;
-    let nominal_fast = Machine::from_model(nominal, geometries(nominal, &[None])?)?;
-    for &s in scenario.speeds_rpm.iter().chain(&scenario.pole_speeds_rpm) {
-        positive("speeds_rpm", s)?;
+    let truth = true_variant(nominal, scenario)?;
+    let (lo, hi) = scenario.speed_range_rpm;
+    positive("speed_range_rpm.0", lo)?;
+    if !(hi >= lo) {
+        return Err(GapError::InvalidInput {
+            field: "speed_range_rpm.1".into(),
+            value: hi,
+            expected: "at least the lowest speed",
+        });
     }
-    let requests: Vec<(f64, usize)> = scenario.speeds_rpm.iter().map(|&s| (s, 0)).collect();
-    let nominal_limits = nominal_fast.boundary(&requests);
+    let (r_lo, r_hi) = scenario.depth_ratio_range;
+    positive("depth_ratio_range.0", r_lo)?;
+    positive("depth_ratio_range.1", r_hi)?;
+    let mut rng = StdRng::seed_from_u64(scenario.seed);
+    let speeds: Vec<f64> = (0..scenario.speeds.max(1))
+        .map(|_| lo + (hi - lo) * rng.random::<f64>())
+        .collect();
+    let limits = speeds
+        .iter()
+        .map(|&s| Ok(true_limiting_depth(nominal, s)?.min(0.05)))
+        .collect::<Result<Vec<f64>>>()?;
     let mut entries = Vec::new();
-    for (&speed_rpm, limit) in scenario.speeds_rpm.iter().zip(&nominal_limits) {
-        if !limit.depth_m.is_finite() {
-            continue;
-        }
-        for &r in &scenario.depth_ratios {
-            entries.push(Entry::Cut {
-                speed_rpm,
-                depth_m: positive("depth_ratios", r)? * limit.depth_m,
-            });
-        }
+    for k in 0..scenario.cuts {
+        let i = k % speeds.len();
+        let ratio = (r_lo.ln() + (r_hi / r_lo).ln() * rng.random::<f64>()).exp();
+        entries.push(Entry::Cut {
+            speed_rpm: speeds[i],
+            depth_m: ratio * limits[i],
+        });
     }
     for &speed_rpm in &scenario.pole_speeds_rpm {
+        positive("pole_speeds_rpm", speed_rpm)?;
         for &fraction in &scenario.pole_depth_fractions {
             entries.push(Entry::Pole {
                 speed_rpm,
@@ -337,52 +592,26 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
             });
         }
     }
-    let mut speeds: Vec<f64> = scenario
-        .speeds_rpm
-        .iter()
-        .chain(&scenario.pole_speeds_rpm)
-        .copied()
-        .collect();
-    speeds.sort_by(f64::total_cmp);
-    speeds.dedup();
-    let true_requests: Vec<(f64, usize)> = speeds.iter().map(|&s| (s, 0)).collect();
-    let true_limits = truth.boundary(&true_requests);
-    let true_limit = |s: f64| {
-        speeds
-            .iter()
-            .position(|x| *x == s)
-            .map_or(f64::INFINITY, |i| true_limits[i].depth_m)
-    };
-    let true_chatter = |s: f64| {
-        speeds
-            .iter()
-            .position(|x| *x == s)
-            .map_or(f64::NAN, |i| true_limits[i].chatter_hz)
-    };
-    let mut rng = StdRng::seed_from_u64(scenario.seed);
     entries.shuffle(&mut rng);
     let n = entries.len().max(2);
-    let jitter = Normal::new(0.0, scenario.chatter_jitter_hz.max(0.0)).map_err(|_| {
-        GapError::InvalidInput {
-            field: "chatter_jitter_hz".into(),
-            value: scenario.chatter_jitter_hz,
-            expected: "a standard deviation >= 0",
-        }
-    })?;
-    let tau_nominal = |s: f64| nominal_fast.delay_s(s);
+    let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
+    let milling = matches!(nominal.operation(), Operation::Milling(_));
     let mut obs = Observations::default();
     for (k, entry) in entries.iter().enumerate() {
         let u = k as f64 / (n - 1) as f64;
         let sequence = (scenario.run_order == RunOrder::Recorded).then_some(k as i64 + 1);
         match *entry {
             Entry::Cut { speed_rpm, depth_m } => {
-                let b_true = true_limit(speed_rpm) / truth.drift_factor(u);
-                let z = (depth_m / b_true).ln() / scenario.label_width_log_depth;
-                let p = 0.5 * chatter_bayes::prior::erfc(-z / std::f64::consts::SQRT_2);
-                let stable = rng.random::<f64>() >= p;
-                let f_true = true_chatter(speed_rpm);
-                let chatter_hz =
-                    (!stable && f_true.is_finite()).then(|| f_true + jitter.sample(&mut rng));
+                let model = truth.at(None, speed_rpm, u)?;
+                let jittered = depth_m * (scenario.label_width_log_depth * normal()).exp();
+                let (ln_mu, _, _) = truth_at(&model, speed_rpm, jittered)?;
+                let stable = ln_mu < 0.0;
+                let chatter_hz = if stable {
+                    None
+                } else {
+                    let (_, f, _) = truth_at(&model, speed_rpm, depth_m)?;
+                    Some(f * (1.0 + scenario.chatter_jitter_relative * normal()))
+                };
                 obs.cuts.push(Cut {
                     speed_rpm,
                     depth_mm: depth_m * 1e3,
@@ -397,25 +626,27 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
                 speed_rpm,
                 fraction,
             } => {
-                let limit = true_limit(speed_rpm) / truth.drift_factor(u);
-                let depth_m = fraction * limit.min(0.05);
-                let Some(lambda) = truth.dominant_pole(speed_rpm, depth_m, 0, u) else {
-                    continue;
+                let model = truth.at(None, speed_rpm, u)?;
+                let depth_m = fraction * true_limiting_depth(&model, speed_rpm)?.min(0.05);
+                let (_, _, lambda) = truth_at(&model, speed_rpm, depth_m)?;
+                let tau = model.operation().delay_s(speed_rpm);
+                // a lifted pole: the principal value of ln(mu) / tau
+                let lambda = if milling {
+                    (lambda * tau).exp().ln() / tau
+                } else {
+                    lambda
                 };
-                let pole = truth.observed_pole(lambda, tau_nominal(speed_rpm));
-                let f_std = scenario.pole_frequency_std_hz;
+                let pole = observed_pole(lambda, milling);
+                let f_std = scenario.pole_frequency_std_relative * pole.frequency_hz;
                 let z_std = scenario.pole_damping_std_relative * pole.damping_ratio.abs();
-                let draw = |rng: &mut StdRng, sd: f64| -> f64 {
-                    Normal::new(0.0, sd).map_or(0.0, |d| d.sample(rng))
-                };
-                let frequency_hz = (pole.frequency_hz + draw(&mut rng, f_std)).abs();
-                let damping_ratio = pole.damping_ratio + draw(&mut rng, z_std);
+                let frequency_hz = (pole.frequency_hz + f_std * normal()).abs();
+                let damping_ratio = pole.damping_ratio + z_std * normal();
                 obs.poles.push(PoleObservation {
                     speed_rpm,
                     depth_mm: depth_m * 1e3,
                     frequency_hz: frequency_hz.max(1e-3),
                     damping_ratio: damping_ratio.clamp(-0.99, 0.99),
-                    frequency_std_hz: Some(f_std),
+                    frequency_std_hz: Some(f_std.max(1e-3)),
                     damping_std: Some(z_std.max(1e-4)),
                     repetitions: Some(10),
                     sequence,

@@ -57,9 +57,10 @@ pub mod diagnose;
 pub mod error;
 pub mod generator;
 pub mod likelihood;
-mod machine;
+pub mod predict;
 pub mod regions;
 pub mod shrink;
+pub mod variant;
 
 pub use check::PredictiveCheck;
 pub use classes::EffectClass;
@@ -70,3 +71,4 @@ pub use diagnose::{
 pub use error::{GapError, Result};
 pub use generator::{HiddenEffect, Recalibration, RunOrder, Scenario, nominal_milling, synthesize};
 pub use likelihood::NoiseModel;
+pub use variant::Variant;

@@ -1,24 +1,21 @@
-//! The observation model: how a machine variant's predictions explain each observation.
+//! The observation model: how a machine variant's predictions ([`crate::predict`]) explain
+//! each observation.
 //!
-//! - A cut at depth b and speed Omega, with the predicted limiting depth b_lim(Omega), chatters
-//!   with probability p = lapse + (1 - 2 lapse) Phi(ln(b / b_lim) / w): a probit in the signed
-//!   log-depth distance to the boundary with width w (label noise near the boundary) and a small
-//!   lapse rate for outright mislabels.
-//! - A chatter frequency f is Gaussian around the predicted f_c with standard deviation s_c,
-//!   folded over the tooth-passing (milling) or spindle (turning) harmonics: the density is
-//!   sum_m N(f - f_c + m f_tp; 0, s_c^2) over the nearest images. Where the cut lies above
-//!   further lobes (near lobe intersections) they may chatter too: the density is a mixture
-//!   of the lowest lobe (weight 1) and the next ones (weight 1/2 times the probability that the
-//!   cut is above them).
+//! - A cut at depth b with signed log-depth distance d = ln(b / b_lim) to the predicted
+//!   boundary (from the Floquet multiplier at the cut itself) chatters with probability
+//!   p = lapse + (1 - 2 lapse) Phi(d / w): a probit with width w (label noise near the boundary,
+//!   and the discretization's error in depth) and a small lapse rate for outright mislabels.
+//! - A chatter frequency f is Gaussian around the frequency of the dominant multiplier at the
+//!   cut's own depth with standard deviation s_c; for milling the residual is folded over the
+//!   tooth-passing harmonics and taken against the nearer of the images k f_tp +- f_mu
+//!   (a wrapped normal).
 //! - A pole's frequency and damping ratio are Gaussian around the predicted pole with the
 //!   observation's standard deviations (or the defaults); a milling pole's principal frequency is
-//!   folded into [0, f_tp / 2] like the data. Where another closed-loop pole decays nearly as
-//!   slowly as the dominant one, the identification may report either: a mixture (weights 1 and
-//!   1/2).
+//!   folded into [0, f_tp / 2] like the data.
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::machine::{BoundaryPoint, Machine, PoleConvention, PredictedPole};
+use crate::predict::{PredictedPole, Prediction};
 use chatter_bayes::prior::erfc;
 use serde::{Deserialize, Serialize};
 
@@ -110,70 +107,6 @@ impl NoiseModel {
     }
 }
 
-/// What a machine variant predicts for a dataset.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Prediction {
-    /// Limiting depth at each cut (m; drift included).
-    pub cut_limit_m: Vec<f64>,
-    /// Chatter frequency at each cut's speed (Hz; NaN where unbounded).
-    pub cut_chatter_hz: Vec<f64>,
-    /// Every lobe at each cut's speed (drift included).
-    pub cut_lobes: Vec<BoundaryPoint>,
-    /// Harmonic spacing at each cut: tooth-passing (milling) or spindle (turning) frequency.
-    pub cut_fold_hz: Vec<f64>,
-    /// The poles each identification may report, with weights (dominant first; empty where
-    /// the continuation failed).
-    pub poles: Vec<Vec<(PredictedPole, f64)>>,
-    /// Fold of each pole's principal frequency (Hz), milling only.
-    pub pole_fold_hz: Vec<Option<f64>>,
-}
-
-/// Predictions of `machine` for `data`.
-pub(crate) fn predict(machine: &Machine, data: &Dataset) -> Prediction {
-    let boundary = if data.cuts.is_empty() {
-        Vec::new()
-    } else {
-        machine.boundary(&data.requests)
-    };
-    let mut cut_lobes = Vec::with_capacity(data.cuts.len());
-    let mut cut_fold_hz = Vec::with_capacity(data.cuts.len());
-    for c in &data.cuts {
-        let lobes = boundary
-            .get(c.request)
-            .map_or(BoundaryPoint::UNBOUNDED, |p| {
-                p.scaled_depth(machine.drift_factor(c.u))
-            });
-        cut_lobes.push(lobes);
-        cut_fold_hz.push(1.0 / machine.delay_s(c.speed_rpm));
-    }
-    let cut_limit_m = cut_lobes.iter().map(|p| p.depth_m).collect();
-    let cut_chatter_hz = cut_lobes.iter().map(|p| p.chatter_hz).collect();
-    let poles = data
-        .poles
-        .iter()
-        .map(|p| machine.poles(p.speed_rpm, p.depth_m, p.geometry, p.u))
-        .collect();
-    let pole_fold_hz = data
-        .poles
-        .iter()
-        .map(|p| {
-            (machine.convention == PoleConvention::Lifted)
-                .then(|| 1.0 / machine.delay_s(p.speed_rpm))
-        })
-        .collect();
-    Prediction {
-        cut_limit_m,
-        cut_chatter_hz,
-        cut_lobes,
-        cut_fold_hz,
-        poles,
-        pole_fold_hz,
-    }
-}
-
-/// Mixture weight of a higher lobe's chatter frequency relative to the lowest lobe's.
-const HIGHER_LOBE_WEIGHT: f64 = 0.5;
-
 /// ln sqrt(2 pi).
 const LN_SQRT_2PI: f64 = 0.918_938_533_204_672_8;
 
@@ -230,27 +163,18 @@ pub(crate) fn pole_frequency_residual(observed: f64, predicted: f64, fold: Optio
         .unwrap_or(f64::NAN)
 }
 
-/// The candidate pole that best explains an observed pole (highest weighted density), with the
-/// frequency residual (nearest image) and the damping residual.
-pub(crate) fn matched_pole(
+/// The frequency residual (nearest image) and damping residual of an observed pole against a
+/// predicted one.
+pub(crate) fn pole_residuals(
     observed_hz: f64,
     observed_damping: f64,
-    frequency_std_hz: f64,
-    damping_std: f64,
-    candidates: &[(PredictedPole, f64)],
+    predicted: &PredictedPole,
     fold: Option<f64>,
-) -> Option<(f64, f64)> {
-    candidates
-        .iter()
-        .map(|(q, w)| {
-            let rf = pole_frequency_residual(observed_hz, q.frequency_hz, fold);
-            let rz = observed_damping - q.damping_ratio;
-            let score =
-                w.ln() - 0.5 * (rf / frequency_std_hz).powi(2) - 0.5 * (rz / damping_std).powi(2);
-            (score, rf, rz)
-        })
-        .max_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, rf, rz)| (rf, rz))
+) -> (f64, f64) {
+    (
+        pole_frequency_residual(observed_hz, predicted.frequency_hz, fold),
+        observed_damping - predicted.damping_ratio,
+    )
 }
 
 /// Log-likelihood of each observation.
@@ -283,63 +207,74 @@ impl Terms {
     }
 }
 
-/// Per-observation log-likelihoods of `data` under `prediction`.
+/// ln of the density of a chatter frequency `f` given the predicted `predicted` and the fold:
+/// milling folds the residual over the tooth-passing harmonics and takes the nearer of the
+/// images k f_tp + f_mu and k f_tp - f_mu; turning compares directly.
+fn ln_chatter_density(f: f64, predicted: f64, s: f64, fold: Option<f64>) -> f64 {
+    match fold {
+        Some(ft) => {
+            let r = chatter_residual(f, predicted, Some(ft));
+            ln_wrapped_normal(r, s, ft)
+        }
+        None => ln_normal(f - predicted, s),
+    }
+}
+
+/// The chatter-frequency residual: folded and against the nearer image for milling.
+pub(crate) fn chatter_residual(f: f64, predicted: f64, fold: Option<f64>) -> f64 {
+    match fold {
+        Some(ft) => {
+            let a = folded(f - predicted, ft);
+            let b = folded(f + predicted, ft);
+            if a.abs() <= b.abs() { a } else { b }
+        }
+        None => f - predicted,
+    }
+}
+
+/// ln 1/2: a label the model cannot predict (solver failure).
+const LN_HALF: f64 = -std::f64::consts::LN_2;
+
+/// Per-observation log-likelihoods of `data` under `prediction`. An observation whose prediction
+/// failed gets a neutral term (label probability 1/2, flat frequency over one harmonic interval
+/// or over [0, 2 f]); the failure is counted by the caller.
 pub(crate) fn terms(prediction: &Prediction, data: &Dataset, noise: &NoiseModel) -> Terms {
     let n = data.cuts.len();
     let mut label = Vec::with_capacity(n);
     let mut chatter = Vec::with_capacity(n);
     for (i, c) in data.cuts.iter().enumerate() {
-        let p = noise.chatter_probability((c.depth_m / prediction.cut_limit_m[i]).ln());
-        label.push(if c.stable { (1.0 - p).ln() } else { p.ln() });
-        chatter.push(c.chatter_hz.map(|f| {
-            let ft = prediction.cut_fold_hz[i];
-            let lobes = &prediction.cut_lobes[i];
-            // the lowest lobe chatters; a higher lobe the cut lies above may (weight 1/2 times
-            // the probability that the cut is above it)
-            let mut ln = Vec::with_capacity(3);
-            let mut total = 0.0;
-            for (k, (b, fc)) in lobes.lobes().enumerate() {
-                let w = if k == 0 {
-                    1.0
-                } else {
-                    HIGHER_LOBE_WEIGHT * (1.0 - noise.chatter_probability((b / c.depth_m).ln()))
-                };
-                ln.push(w.ln() + ln_wrapped_normal(f - fc, data.chatter_std_hz, ft));
-                total += w;
+        let predicted = prediction.cuts[i];
+        label.push(match predicted {
+            Some(q) => {
+                let p = noise.chatter_probability(q.log_distance());
+                if c.stable { (1.0 - p).ln() } else { p.ln() }
             }
-            if ln.is_empty() {
-                // no lobe at this speed: any frequency in a harmonic interval
-                -ft.ln()
-            } else {
-                log_sum_exp(&ln) - total.ln()
-            }
+            None => LN_HALF,
+        });
+        let fold = prediction.cut_fold_hz[i];
+        chatter.push(c.chatter_hz.map(|f| match predicted {
+            Some(q) => ln_chatter_density(f, q.chatter_hz, data.chatter_std_hz, fold),
+            None => -fold.unwrap_or(2.0 * f.max(1.0)).ln(),
         }));
     }
     let pole = data
         .poles
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let candidates = &prediction.poles[i];
-            if candidates.is_empty() {
-                // the model has no pole to offer: a flat density over the plausible range
-                return -(2.0 * p.frequency_hz.max(1.0)).ln();
-            }
-            let total: f64 = candidates.iter().map(|c| c.1).sum();
-            let ln: Vec<f64> = candidates
-                .iter()
-                .flat_map(|(q, w)| {
-                    let z = ln_normal(p.damping_ratio - q.damping_ratio, p.damping_std);
-                    pole_frequency_images(
-                        p.frequency_hz,
-                        q.frequency_hz,
-                        prediction.pole_fold_hz[i],
-                    )
-                    .into_iter()
-                    .map(move |r| w.ln() + z + ln_normal(r, p.frequency_std_hz))
-                })
+        .map(|(i, p)| match prediction.poles[i] {
+            Some(q) => {
+                let z = ln_normal(p.damping_ratio - q.damping_ratio, p.damping_std);
+                let ln: Vec<f64> = pole_frequency_images(
+                    p.frequency_hz,
+                    q.frequency_hz,
+                    prediction.pole_fold_hz[i],
+                )
+                .into_iter()
+                .map(|r| z + ln_normal(r, p.frequency_std_hz))
                 .collect();
-            log_sum_exp(&ln) - total.ln()
+                log_sum_exp(&ln)
+            }
+            None => -(2.0 * p.frequency_hz.max(1.0)).ln(),
         })
         .collect();
     Terms {

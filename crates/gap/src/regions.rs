@@ -12,7 +12,8 @@
 //! the total misfit of the nominal model.
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, Prediction, folded, matched_pole};
+use crate::likelihood::{NoiseModel, chatter_residual, pole_residuals};
+use crate::predict::Prediction;
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -87,18 +88,14 @@ pub(crate) fn residuals(prediction: &Prediction, data: &Dataset, noise: &NoiseMo
         .iter()
         .enumerate()
         .map(|(i, c)| {
-            let limit = prediction.cut_limit_m[i];
-            let d = (c.depth_m / limit).ln();
+            let predicted = prediction.cuts[i];
+            let d = predicted.map_or(f64::NAN, |q| q.log_distance());
+            let limit = c.depth_m / d.exp();
             let p = noise.chatter_probability(d);
             let observed = if c.stable { 1.0 - p } else { p };
             let label_misfit = -observed.ln() + p.max(1.0 - p).ln();
             let chatter_residual_hz = c.chatter_hz.and_then(|f| {
-                let lobes = &prediction.cut_lobes[i];
-                lobes
-                    .lobes()
-                    .filter(|(b, _)| *b <= c.depth_m.max(lobes.depth_m))
-                    .map(|(_, fc)| folded(f - fc, prediction.cut_fold_hz[i]))
-                    .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+                predicted.map(|q| chatter_residual(f, q.chatter_hz, prediction.cut_fold_hz[i]))
             });
             let chatter_misfit =
                 chatter_residual_hz.map_or(0.0, |r| 0.5 * (r / data.chatter_std_hz).powi(2));
@@ -121,15 +118,14 @@ pub(crate) fn residuals(prediction: &Prediction, data: &Dataset, noise: &NoiseMo
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let (fr, zr) = matched_pole(
-                p.frequency_hz,
-                p.damping_ratio,
-                p.frequency_std_hz,
-                p.damping_std,
-                &prediction.poles[i],
-                prediction.pole_fold_hz[i],
-            )
-            .unwrap_or((f64::NAN, f64::NAN));
+            let (fr, zr) = prediction.poles[i].map_or((f64::NAN, f64::NAN), |q| {
+                pole_residuals(
+                    p.frequency_hz,
+                    p.damping_ratio,
+                    &q,
+                    prediction.pole_fold_hz[i],
+                )
+            });
             let misfit = if fr.is_finite() {
                 0.5 * (fr / p.frequency_std_hz).powi(2) + 0.5 * (zr / p.damping_std).powi(2)
             } else {
@@ -588,20 +584,26 @@ mod tests {
     #[test]
     fn the_nominal_model_has_no_gap_on_its_own_data() {
         use crate::generator::{HiddenEffect, Scenario, nominal_milling, synthesize};
-        use crate::machine::{Machine, geometries};
         let model = nominal_milling().unwrap();
         let mut scenario = Scenario::new(HiddenEffect::ParameterError, 4);
         scenario.label_width_log_depth = 1e-3;
         let obs = synthesize(&model, &scenario).unwrap();
         let noise = NoiseModel::default();
         let data = Dataset::new(&model, &obs, &noise, 750.0).unwrap();
-        let machine = Machine::from_model(&model, geometries(&model, &[None]).unwrap()).unwrap();
-        let r = residuals(&crate::likelihood::predict(&machine, &data), &data, &noise);
-        // (the cuts at exactly the nominal limit may go either way)
+        let variant = crate::variant::Variant::new(model.clone());
+        let r = residuals(&crate::predict::predict(&variant, &data), &data, &noise);
+        // the truth (semi-discretization, 4x resolution) and the prediction (full
+        // discretization) differ by up to ~2 % in depth: only cuts that close may disagree
         assert!(
             r.cuts
                 .iter()
-                .all(|c| !c.disagrees || c.log_depth_distance.abs() < 0.01)
+                .all(|c| !c.disagrees || c.log_depth_distance.abs() < 0.03),
+            "{:?}",
+            r.cuts
+                .iter()
+                .filter(|c| c.disagrees)
+                .map(|c| c.log_depth_distance)
+                .collect::<Vec<_>>()
         );
         let context = RegionContext {
             min_limit_mm: r

@@ -16,7 +16,8 @@ use crate::classes::{EffectClass, Nominal};
 use crate::data::Dataset;
 use crate::diagnose::{DiagnoseOptions, Validation, class_seed, fit, posterior_predictions};
 use crate::error::Result;
-use crate::likelihood::{NoiseModel, Prediction, predict, terms};
+use crate::likelihood::{NoiseModel, terms};
+use crate::predict::{Prediction, predict};
 use crate::regions::residuals;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -93,7 +94,9 @@ impl Pool {
             self.lpd.push(log_mean(&mut all.iter().map(|t| t.cut(i))));
             let p = predictions
                 .iter()
-                .map(|pr| noise.chatter_probability((c.depth_m / pr.cut_limit_m[i]).ln()))
+                .map(|pr| {
+                    noise.chatter_probability(pr.cuts[i].map_or(f64::NAN, |q| q.log_distance()))
+                })
                 .sum::<f64>()
                 / predictions.len() as f64;
             self.labels.push((!c.stable, p > 0.5));
@@ -215,7 +218,7 @@ pub(crate) fn shrink(
         if test.len() == 0 || train.len() == 0 {
             continue;
         }
-        before.add(&[predict(&nominal.machine, &test)], &test, &options.noise);
+        before.add(&[predict(&nominal.variant(), &test)], &test, &options.noise);
         let fitted = fit(
             class,
             nominal,

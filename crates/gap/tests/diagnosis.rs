@@ -1,201 +1,165 @@
-//! The diagnosis on synthetic shop-floor data whose effect is withheld: verdicts for a clear
-//! case of each class, `unexplained` for an effect outside the list, held-out shrinkage for the
-//! correct verdicts, and the confounded pairs separated by the data that break the tie.
+//! The diagnosis on proving-ground campaigns whose truth comes from another solver than the
+//! inference (semi-discretization at 4x resolution against the full discretization at the
+//! automatic one): the control is `consistent`, a clear case of a class gets its name, an
+//! effect outside the list is `unexplained`, no solver failure goes uncounted, and the result
+//! does not depend on the number of threads. The full confusion matrix over four machines and
+//! three magnitudes is `examples/confusion.rs` (its figures are in the closing notes).
 #![allow(clippy::unwrap_used)]
 
+use chatter_gap::generator::{effect_at, proving_machines};
 use chatter_gap::{
     DiagnoseOptions, Diagnosis, EffectClass, HiddenEffect, Quiet, Recalibration, Scenario,
     Validation, diagnose, nominal_milling, synthesize,
 };
 
-fn run(scenario: &Scenario, validation: Validation) -> Diagnosis {
-    let nominal = nominal_milling().unwrap();
-    let data = synthesize(&nominal, scenario).unwrap();
-    let options = DiagnoseOptions {
-        seed: 11,
-        validation,
+fn options(seed: u64) -> DiagnoseOptions {
+    DiagnoseOptions {
+        seed,
+        validation: Validation::Off,
         ..DiagnoseOptions::default()
-    };
-    diagnose(&nominal, &data, &options, &Quiet).unwrap()
-}
-
-fn probability(d: &Diagnosis, class: EffectClass) -> f64 {
-    d.classes
-        .iter()
-        .find(|c| c.name == class)
-        .map_or(0.0, |c| c.probability)
+    }
 }
 
 fn summary(d: &Diagnosis) -> String {
-    d.classes
+    let classes = d
+        .classes
         .iter()
         .map(|c| format!("{} {:.1} ({:.3})", c.name, c.log_evidence, c.probability))
         .collect::<Vec<_>>()
-        .join(", ")
+        .join(", ");
+    format!(
+        "verdict {}, nominal ln L {:.1}, nominal check {:?}, best check {:?}; {classes}",
+        d.verdict.name(),
+        d.nominal_log_evidence,
+        d.nominal_check,
+        d.predictive_check
+    )
 }
 
-/// A clear case gets its name, confidently, and adding the effect shrinks the gap on held-out
-/// folds: a higher predictive density and fewer misclassified cuts.
-fn clear_case(effect: HiddenEffect, error: Recalibration, seed: u64) {
-    let mut scenario = Scenario::new(effect, seed);
+/// Diagnose a campaign of `effect` on machine `machine` and return the diagnosis.
+fn campaign(
+    machine: usize,
+    effect: HiddenEffect,
+    error: Recalibration,
+    seed: u64,
+    classes: &[EffectClass],
+) -> Diagnosis {
+    let m = &proving_machines().unwrap()[machine];
+    let (lo, hi) = m.speed_range_rpm;
+    let mut scenario = Scenario::new(effect, seed).with_speed_range(lo, hi, 4);
     scenario.error = error;
-    let d = run(&scenario, Validation::KFold { folds: 4 });
-    let expected = effect.expected_class().unwrap();
+    let data = synthesize(&m.model, &scenario).unwrap();
+    let options = DiagnoseOptions {
+        classes: classes.to_vec(),
+        ..options(seed)
+    };
+    let d = diagnose(&m.model, &data, &options, &Quiet).unwrap();
+    eprintln!("{} / {effect:?}: {}", m.name, summary(&d));
+    for c in &d.classes {
+        assert!(!c.failures_flagged, "{}: {c:?}", c.name);
+    }
+    d
+}
+
+#[test]
+fn the_right_model_is_consistent() {
+    let d = campaign(
+        0,
+        HiddenEffect::ParameterError,
+        Recalibration::default(),
+        21,
+        &[EffectClass::ParameterError, EffectClass::ExtraMode],
+    );
+    assert_eq!(d.verdict.name(), "consistent", "{}", summary(&d));
+    // the consistent verdict's model is the nominal one
+    assert_eq!(d.diagnosed_model(), &proving_machines().unwrap()[0].model);
+}
+
+#[test]
+fn a_recalibration_error_is_a_parameter_error() {
+    let m = &proving_machines().unwrap()[0];
+    let (effect, error) = effect_at(
+        EffectClass::ParameterError,
+        1.0,
+        &m.model,
+        m.speed_range_rpm,
+    )
+    .unwrap();
+    let d = campaign(
+        0,
+        effect,
+        error,
+        22,
+        &[EffectClass::ParameterError, EffectClass::ExtraMode],
+    );
+    assert_eq!(d.verdict.name(), "parameter_error", "{}", summary(&d));
+    // the fitted ratio of cutting coefficients to stiffness: truth 1.36; the posterior mean
+    // within 10 % (the label width and pole noise allow a few per cent)
+    let fitted = d.classes[0].parameters["cutting_over_stiffness_factor"].mean;
+    assert!((fitted / 1.36 - 1.0).abs() < 0.1, "{fitted}");
+}
+
+#[test]
+fn speed_dependent_modes_are_named() {
+    let m = &proving_machines().unwrap()[0];
+    let (effect, error) = effect_at(
+        EffectClass::SpeedDependentDynamics,
+        2.0,
+        &m.model,
+        m.speed_range_rpm,
+    )
+    .unwrap();
+    let d = campaign(
+        0,
+        effect,
+        error,
+        23,
+        &[
+            EffectClass::ParameterError,
+            EffectClass::SpeedDependentDynamics,
+        ],
+    );
     assert_eq!(
         d.verdict.name(),
-        expected.name(),
-        "{effect:?}: {}",
+        "speed_dependent_dynamics",
+        "{}",
         summary(&d)
     );
-    assert!(
-        probability(&d, expected) > 0.6,
-        "{effect:?}: {}",
-        summary(&d)
-    );
-    let shrink = d.shrink.unwrap();
-    let lpd = shrink.log_predictive_density_per_observation;
-    let bmr = shrink.balanced_misclassification.unwrap();
-    eprintln!("{expected}: misclassification {bmr:?}, lpd {lpd:?}");
-    assert!(lpd.after > lpd.before, "{effect:?}: {lpd:?}");
-    assert!(bmr.after < bmr.before, "{effect:?}: {bmr:?}");
 }
 
-#[test]
-fn clear_parameter_error() {
-    let error = Recalibration {
-        frequency_factor: 0.97,
-        damping_factor: 1.5,
-        cutting_over_stiffness_factor: 0.8,
-    };
-    clear_case(HiddenEffect::ParameterError, error, 100);
-}
-
-#[test]
-fn clear_process_damping() {
-    let effect = HiddenEffect::ProcessDamping { c_n_per_m: 6e4 };
-    clear_case(effect, Recalibration::default(), 101);
-}
-
-#[test]
-fn clear_speed_dependent_dynamics() {
-    let effect = HiddenEffect::SpeedDependentDynamics {
-        frequency_drop_at_max_speed: 0.06,
-    };
-    clear_case(effect, Recalibration::default(), 102);
-}
-
-#[test]
-fn clear_extra_mode() {
-    let effect = HiddenEffect::ExtraMode {
-        frequency_hz: 1150.0,
-        damping_ratio: 0.02,
-        stiffness_n_per_m: 4e6,
-        direction_deg: 30.0,
-    };
-    clear_case(effect, Recalibration::default(), 103);
-}
-
-#[test]
-fn clear_drift() {
-    let effect = HiddenEffect::Drift {
-        cutting_change_over_campaign: 0.6,
-    };
-    clear_case(effect, Recalibration::default(), 104);
-}
-
-/// Runout that leaves only two of the four teeth cutting is outside the candidate list: no class
-/// explains it, so the verdict is `unexplained` and the check names what fails.
 #[test]
 fn an_effect_outside_the_list_is_unexplained() {
-    let d = run(
-        &Scenario::new(HiddenEffect::Runout { cutting_teeth: 2 }, 7),
-        Validation::Off,
+    let m = &proving_machines().unwrap()[0];
+    let (lo, hi) = m.speed_range_rpm;
+    let effect = HiddenEffect::CuttingBand {
+        from_rpm: lo + 0.3 * (hi - lo),
+        to_rpm: lo + 0.7 * (hi - lo),
+        factor: 3.0,
+    };
+    let d = campaign(
+        0,
+        effect,
+        Recalibration::default(),
+        24,
+        &[EffectClass::ParameterError, EffectClass::Drift],
     );
     assert_eq!(d.verdict.name(), "unexplained", "{}", summary(&d));
-    assert!(!d.predictive_check.passed);
-    assert!(d.regions.iter().any(|r| r.gap_share > 0.2));
-}
-
-/// Each confounded pair is separated by the data that break the tie: a pure damping error is
-/// not mistaken for process damping (low-speed cuts), a pure frequency error not for
-/// speed-dependent dynamics (chatter frequencies and poles at low speed), a constant
-/// cutting-coefficient error not for drift (`sequence`): the verdict is `parameter_error`, the
-/// confound is not confidently preferred (the classes are nested, so their evidences differ by
-/// little more than an Occam factor), and its own fit finds its effect near zero (well below the
-/// clear cases' 6e4 N/m, 6 % and 60 %). The other half of each pair is in
-/// the `clear_*` tests.
-#[test]
-fn confounded_pairs_are_separated() {
-    let cases = [
-        (
-            Recalibration {
-                damping_factor: 1.8,
-                ..Recalibration::default()
-            },
-            EffectClass::ProcessDamping,
-            "c_n_per_m",
-            2e4,
-        ),
-        (
-            Recalibration {
-                frequency_factor: 0.95,
-                ..Recalibration::default()
-            },
-            EffectClass::SpeedDependentDynamics,
-            "frequency_drop_at_max_speed",
-            0.02,
-        ),
-        (
-            Recalibration {
-                cutting_over_stiffness_factor: 1.35,
-                ..Recalibration::default()
-            },
-            EffectClass::Drift,
-            "cutting_change_over_campaign",
-            0.2,
-        ),
-    ];
-    for (k, (error, confound, parameter, bound)) in cases.into_iter().enumerate() {
-        let mut scenario = Scenario::new(HiddenEffect::ParameterError, 200 + k as u64);
-        scenario.error = error;
-        let d = run(&scenario, Validation::Off);
-        assert_eq!(
-            d.verdict.name(),
-            "parameter_error",
-            "{error:?}: {}",
-            summary(&d)
-        );
-        assert!(
-            probability(&d, confound) < 0.8,
-            "{error:?}: {}",
-            summary(&d)
-        );
-        let fitted = d.classes.iter().find(|c| c.name == confound).unwrap();
-        let effect = fitted.parameters[parameter].mean;
-        eprintln!("{error:?}: {confound} fits {parameter} = {effect}");
-        assert!(
-            effect.abs() < bound,
-            "{error:?}: {confound} {parameter} = {effect}"
-        );
-    }
 }
 
 /// The result does not depend on the number of threads.
 #[test]
 fn independent_of_thread_count() {
     let nominal = nominal_milling().unwrap();
-    let scenario = Scenario::new(
-        HiddenEffect::Drift {
-            cutting_change_over_campaign: 0.5,
-        },
-        3,
-    );
+    let mut scenario = Scenario::new(HiddenEffect::ParameterError, 3);
+    scenario.cuts = 12;
+    scenario.pole_speeds_rpm.truncate(2);
     let data = synthesize(&nominal, &scenario).unwrap();
     let options = DiagnoseOptions {
         seed: 5,
         samples: 60,
-        classes: vec![EffectClass::ParameterError, EffectClass::Drift],
-        validation: Validation::Off,
+        classes: vec![EffectClass::ParameterError],
+        validation: Validation::KFold { folds: 2 },
+        validation_samples: 50,
         ..DiagnoseOptions::default()
     };
     let json = |threads: usize| {
@@ -216,7 +180,9 @@ fn bad_input_is_rejected() {
     let empty = chatter_dynamics::Observations::default();
     let err = diagnose(&nominal, &empty, &DiagnoseOptions::default(), &Quiet).unwrap_err();
     assert!(err.to_string().contains("no cuts and no poles"), "{err}");
-    let data = synthesize(&nominal, &Scenario::new(HiddenEffect::ParameterError, 1)).unwrap();
+    let mut scenario = Scenario::new(HiddenEffect::ParameterError, 1);
+    scenario.cuts = 4;
+    let data = synthesize(&nominal, &scenario).unwrap();
     let options = DiagnoseOptions {
         validation: Validation::KFold { folds: 1 },
         ..DiagnoseOptions::default()

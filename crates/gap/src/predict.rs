@@ -1,0 +1,196 @@
+//! What a machine variant predicts for each observation, from the Floquet multiplier of the
+//! periodic delay equation at the observation's own cutting condition.
+//!
+//! Every prediction is one dominant multiplier mu of the first-order full discretization
+//! (`chatter_stability::monodromy`, 000 Eq. 9-11, automatic resolution: at least 40 steps and 24
+//! steps per vibration period of the highest mode while cutting) of the variant's model at the
+//! cut's speed, depth, radial immersion and campaign position. No limiting depth is searched:
+//! - a **cut** is described by ln|mu| at its depth and by ln|mu_0| = -min_n zeta_n w_n tau, the
+//!   multiplier without cutting. Linear interpolation of ln|mu| in depth between b = 0 and the
+//!   cut places the boundary at b_lim = b ln|mu_0| / (ln|mu_0| - ln|mu|), so the signed
+//!   log-depth distance of the cut to the boundary is d = ln((ln|mu| - ln|mu_0|) / -ln|mu_0|).
+//!   d = 0 exactly where |mu| = 1; away from it d is approximate, which only shapes the label
+//!   noise.
+//! - a **chattering cut**'s frequency is that of the dominant multiplier at the cut's own depth
+//!   (not at the boundary): the principal frequency arg(mu) / (2 pi tau) with its images
+//!   k / tau +- f_mu for milling, the eigenfunction's frequency for turning.
+//! - an identified **pole** at a stable cut is lambda = ln(mu) / tau: lifted over the tooth
+//!   period for milling (principal frequency |Im lambda| / 2 pi, damping -Re lambda / |lambda|,
+//!   as in 002), physical for turning (Im lambda from the eigenfunction's frequency, 000 Eq. 6).
+//!
+//! # Accuracy
+//! Against the semi-discretization at 400 steps per delay (the proving ground's truth) the
+//! automatic resolution errs by at most about 2 % in limiting depth and 0.1 % in frequency on
+//! the test machines (see `tests/proving_ground.rs`); the label width (8 % in depth) and the
+//! frequency noise (0.3-1 %) cover it.
+//!
+//! # Failures
+//! A solver error is never read as stable: the observation gets no prediction (`None`), the
+//! likelihood gives it a neutral term and the failure is counted and reported per class.
+
+use crate::data::Dataset;
+use crate::variant::Variant;
+use chatter_dynamics::{ModalModel, Operation};
+use chatter_stability::StabilitySolver;
+use chatter_stability::monodromy::Discretization;
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// A predicted cut.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CutPrediction {
+    /// ln|mu| at the cut's depth.
+    pub ln_modulus: f64,
+    /// ln|mu| without cutting.
+    pub ln_modulus_free: f64,
+    /// Predicted chatter frequency (Hz): principal (milling) or physical (turning).
+    pub chatter_hz: f64,
+}
+
+impl CutPrediction {
+    /// Signed log-depth distance d = ln(b / b_lim) of the cut to the boundary (module docs).
+    pub fn log_distance(&self) -> f64 {
+        let l0 = self.ln_modulus_free.min(-1e-9);
+        let ratio = (self.ln_modulus - l0) / -l0;
+        ratio.max(1e-6).ln()
+    }
+}
+
+/// A pole as an identification reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PredictedPole {
+    pub frequency_hz: f64,
+    pub damping_ratio: f64,
+}
+
+/// What a variant predicts for a dataset.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Prediction {
+    /// Each cut (None: the solver failed).
+    pub cuts: Vec<Option<CutPrediction>>,
+    /// Fold of each cut's chatter frequency: tooth passing (milling), None for turning.
+    pub cut_fold_hz: Vec<Option<f64>>,
+    /// Each pole (None: the solver failed).
+    pub poles: Vec<Option<PredictedPole>>,
+    /// Fold of each pole's principal frequency (milling only).
+    pub pole_fold_hz: Vec<Option<f64>>,
+    /// Solver failures among the evaluations.
+    pub failures: usize,
+}
+
+impl Prediction {
+    /// Multiplier evaluations behind the prediction.
+    pub fn evaluations(&self) -> usize {
+        self.cuts.len() + self.poles.len()
+    }
+}
+
+/// The solver of every prediction.
+fn solver() -> Discretization {
+    Discretization::full()
+}
+
+/// ln|mu| without cutting: the slowest free decay over one delay.
+fn free_ln_modulus(model: &ModalModel, tau_s: f64) -> f64 {
+    -model
+        .modes()
+        .iter()
+        .map(|m| m.damping_ratio() * m.omega_rad_s())
+        .fold(f64::INFINITY, f64::min)
+        * tau_s
+}
+
+fn milling(model: &ModalModel) -> bool {
+    matches!(model.operation(), Operation::Milling(_))
+}
+
+/// The prediction of one cut of `variant` (speed rpm, depth m, immersion, position).
+pub(crate) fn predict_cut(
+    variant: &Variant,
+    speed_rpm: f64,
+    depth_m: f64,
+    immersion: Option<f64>,
+    u: f64,
+    with_frequency: bool,
+) -> Option<CutPrediction> {
+    let model = variant.at(immersion, speed_rpm, u).ok()?;
+    let tau = model.operation().delay_s(speed_rpm);
+    let s = solver();
+    let (mu, chatter_hz) = if with_frequency && !milling(&model) {
+        s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?
+    } else {
+        let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
+        (mu, mu.principal_frequency_hz())
+    };
+    let ln_modulus = mu.modulus().ln();
+    ln_modulus.is_finite().then_some(CutPrediction {
+        ln_modulus,
+        ln_modulus_free: free_ln_modulus(&model, tau),
+        chatter_hz,
+    })
+}
+
+/// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).
+pub(crate) fn predict_pole(
+    variant: &Variant,
+    speed_rpm: f64,
+    depth_m: f64,
+    immersion: Option<f64>,
+    u: f64,
+) -> Option<PredictedPole> {
+    let model = variant.at(immersion, speed_rpm, u).ok()?;
+    let s = solver();
+    let (mu, physical_hz) = if milling(&model) {
+        let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
+        (mu, mu.principal_frequency_hz())
+    } else {
+        s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?
+    };
+    let lambda = Complex64::new(mu.modulus().ln() / mu.period_s, 2.0 * PI * physical_hz);
+    let pole = observed_pole(lambda, milling(&model));
+    (pole.frequency_hz.is_finite() && pole.damping_ratio.is_finite()).then_some(pole)
+}
+
+/// A continuous-time pole as it is identified: frequency |Im lambda| / 2 pi for a lifted
+/// (milling) pole, |lambda| / 2 pi for a physical one (000 Eq. 6); damping -Re lambda / |lambda|.
+pub(crate) fn observed_pole(lambda: Complex64, lifted: bool) -> PredictedPole {
+    let w = lambda.norm();
+    PredictedPole {
+        frequency_hz: if lifted { lambda.im.abs() } else { w } / (2.0 * PI),
+        damping_ratio: if w > 0.0 { -lambda.re / w } else { 0.0 },
+    }
+}
+
+/// Predictions of `variant` for every observation of `data` (in parallel over observations).
+pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
+    let immersion = |g: usize| data.immersions.get(g).copied().flatten();
+    let fold = |speed: f64| milling(&variant.model).then(|| 1.0 / variant.delay_s(speed));
+    let cuts: Vec<Option<CutPrediction>> = data
+        .cuts
+        .iter()
+        .map(|c| {
+            predict_cut(
+                variant,
+                c.speed_rpm,
+                c.depth_m,
+                immersion(c.geometry),
+                c.u,
+                c.chatter_hz.is_some(),
+            )
+        })
+        .collect();
+    let poles: Vec<Option<PredictedPole>> = data
+        .poles
+        .iter()
+        .map(|p| predict_pole(variant, p.speed_rpm, p.depth_m, immersion(p.geometry), p.u))
+        .collect();
+    let failures =
+        cuts.iter().filter(|c| c.is_none()).count() + poles.iter().filter(|p| p.is_none()).count();
+    Prediction {
+        cut_fold_hz: data.cuts.iter().map(|c| fold(c.speed_rpm)).collect(),
+        pole_fold_hz: data.poles.iter().map(|p| fold(p.speed_rpm)).collect(),
+        cuts,
+        poles,
+        failures,
+    }
+}
