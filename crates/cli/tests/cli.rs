@@ -314,18 +314,23 @@ fn montecarlo_bands_and_map() {
     );
 }
 
-/// Synthetic shop-floor data with hidden process damping: `chatter diagnose` names it, reports
-/// every class, the regions and the held-out shrinkage, and writes the plots.
+/// Proving-ground data with hidden process damping (2x, truth by semi-discretization):
+/// `chatter diagnose` names it, reports every class, the regions and the held-out shrinkage,
+/// and writes the plots and the diagnosed model, which `chatter lobes` reads.
 #[test]
 fn diagnose_names_the_hidden_effect_and_writes_plots() {
-    use chatter_gap::{HiddenEffect, Scenario, nominal_milling, synthesize};
+    use chatter_gap::{EffectClass, HiddenEffect, Scenario, nominal_milling, synthesize};
     let dir = tempfile::tempdir().unwrap();
     let nominal = nominal_milling().unwrap();
-    let data = synthesize(
+    let mut scenario = Scenario::new(HiddenEffect::ParameterError, 5);
+    (scenario.effect, _) = chatter_gap::generator::effect_at(
+        EffectClass::ProcessDamping,
+        2.0,
         &nominal,
-        &Scenario::new(HiddenEffect::ProcessDamping { c_n_per_m: 6e4 }, 5),
+        scenario.speed_range_rpm,
     )
     .unwrap();
+    let data = synthesize(&nominal, &scenario).unwrap();
     let model_path = dir.path().join("model.json");
     let obs_path = dir.path().join("observations.json");
     std::fs::write(&model_path, nominal.to_json_string()).unwrap();
@@ -357,9 +362,22 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
     let lpd = &report["shrink"]["log_predictive_density_per_observation"];
     assert!(lpd["after"].as_f64().unwrap() > lpd["before"].as_f64().unwrap());
     assert!(report.get("residuals").is_none());
-    for file in ["diagnosis.json", "lobes.svg", "residuals.svg"] {
+    for file in [
+        "diagnosis.json",
+        "lobes.svg",
+        "residuals.svg",
+        "diagnosed_model.json",
+    ] {
         assert!(out_dir.join(file).exists(), "{file}");
     }
+    let diagnosed = chatter_dynamics::ModalModel::from_path(out_dir.join("diagnosed_model.json"))
+        .unwrap();
+    assert!(diagnosed.process_damping_n_per_m().is_some());
+    succeed(
+        chatter()
+            .args(["lobes", "--method", "fdm", "--speeds", "3000:4000:3", "--model"])
+            .arg(out_dir.join("diagnosed_model.json")),
+    );
     let full: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("diagnosis.json")).unwrap())
             .unwrap();
@@ -368,7 +386,7 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
             .as_array()
             .unwrap()
             .len()
-            > 100
+            == scenario.cuts
     );
 }
 

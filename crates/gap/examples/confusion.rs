@@ -5,7 +5,8 @@
 //! (the diagnosis uses the full discretization); held-out cuts drawn from the truth measure how
 //! much of the nominal model's misclassification the diagnosed model closes.
 //!
-//! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1]`
+//! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1
+//! --classes drift --cuts 40 --samples 120 --steps 1]`
 
 use chatter_gap::generator::{effect_at, proving_machines, true_variant};
 use chatter_gap::{
@@ -135,6 +136,9 @@ fn main() -> chatter_gap::Result<()> {
             for seed in 0..seeds {
                 let mut scenario = Scenario::new(effect, 1000 + seed).with_speed_range(lo, hi, 4);
                 scenario.error = error;
+                if let Some(cuts) = arg("--cuts").and_then(|s| s.parse().ok()) {
+                    scenario.cuts = cuts;
+                }
                 let start = Instant::now();
                 let data = synthesize(&machine.model, &scenario)?;
                 eprintln!("synthesized in {:.1} s", start.elapsed().as_secs_f64());

@@ -313,9 +313,9 @@ pub fn proving_machines() -> Result<Vec<ProvingMachine>> {
                 2,
                 0.07,
                 MillingDirection::Up,
-                vec![mode(900.0, 0.02, 6e6, 0)?, mode(960.0, 0.025, 7e6, 1)?],
+                vec![mode(900.0, 0.02, 2e6, 0)?, mode(960.0, 0.025, 2.4e6, 1)?],
             )?,
-            speed_range_rpm: (8000.0, 30000.0),
+            speed_range_rpm: (8000.0, 24000.0),
         },
         ProvingMachine {
             name: "two modes in x",

@@ -19,10 +19,9 @@
 //!   as in 002), physical for turning (Im lambda from the eigenfunction's frequency, 000 Eq. 6).
 //!
 //! # Accuracy
-//! Against the semi-discretization at 400 steps per delay (the proving ground's truth) the
-//! automatic resolution errs by at most about 2 % in limiting depth and 0.1 % in frequency on
-//! the test machines (see `tests/proving_ground.rs`); the label width (8 % in depth) and the
-//! frequency noise (0.3-1 %) cover it.
+//! Against the semi-discretization at four times the resolution (the proving ground's truth)
+//! the automatic resolution errs by at most 0.6 % in limiting depth on the test machines (see
+//! `tests/proving_ground.rs`); the label width (8 % in depth) covers it.
 //!
 //! # Failures
 //! A solver error is never read as stable: the observation gets no prediction (`None`), the

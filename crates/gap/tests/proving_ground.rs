@@ -117,6 +117,7 @@ fn truth_boundary_brackets_an_independent_time_integration() {
         let (lo, hi) = machine.speed_range_rpm;
         for speed in [lo + 0.3 * (hi - lo), lo + 0.8 * (hi - lo)] {
             let b = true_limiting_depth(&machine.model, speed).unwrap();
+            assert!(b < 0.05, "{} at {speed}: no lobe below 50 mm", machine.name);
             let below = growth_per_delay(&machine.model, speed, 0.95 * b, 240);
             let above = growth_per_delay(&machine.model, speed, 1.05 * b, 240);
             eprintln!(
@@ -207,7 +208,12 @@ fn the_inference_solver_errs_by_at_most_3_percent_in_depth() {
             )
             .unwrap()
             .depth_m;
-            let e = (fast / truth - 1.0).abs();
+            // both unbounded (above the 100 mm ceiling) agree
+            let e = if fast.is_infinite() && truth.is_infinite() {
+                0.0
+            } else {
+                (fast / truth - 1.0).abs()
+            };
             worst = worst.max(e);
             eprintln!("{} {speed:.0} rpm: error {:.2} %", machine.name, 100.0 * e);
         }
