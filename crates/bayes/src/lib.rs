@@ -60,4 +60,4 @@ pub mod tmcmc;
 
 pub use error::{BayesError, Result};
 pub use prior::Prior;
-pub use tmcmc::LogLikelihood;
+pub use tmcmc::{LikelihoodFailure, LogLikelihood};

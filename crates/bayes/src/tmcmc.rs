@@ -20,10 +20,51 @@ use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
+/// Why a log-likelihood has no finite value at a parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LikelihoodFailure {
+    /// theta lies outside the model's support (no valid model): probability zero, as a prior
+    /// bound would say.
+    OutsideSupport,
+    /// The model is valid but computing its prediction failed (a solver did not converge).
+    /// Samplers reject the point like an impossible one but count it and report the count, so
+    /// a numerical failure is never mistaken for a parameter the data rule out.
+    Numerical,
+}
+
 /// A log-likelihood ln p(D | theta); -inf where theta is impossible.
 pub trait LogLikelihood: Sync {
     /// ln p(D | theta).
     fn ln_likelihood(&self, theta: &[f64]) -> f64;
+
+    /// ln p(D | theta) with the reason when there is none. The default reads -inf as outside
+    /// the support and NaN as a numerical failure; likelihoods that call solvers override it.
+    fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
+        let l = self.ln_likelihood(theta);
+        if l.is_nan() {
+            Err(LikelihoodFailure::Numerical)
+        } else if l == f64::NEG_INFINITY {
+            Err(LikelihoodFailure::OutsideSupport)
+        } else {
+            Ok(l)
+        }
+    }
+}
+
+/// Evaluate `likelihood` at `theta`: -inf for either failure, counting numerical ones.
+pub(crate) fn counted_ln_likelihood<L: LogLikelihood + ?Sized>(
+    likelihood: &L,
+    theta: &[f64],
+    failures: &std::sync::atomic::AtomicUsize,
+) -> f64 {
+    match likelihood.try_ln_likelihood(theta) {
+        Ok(l) => l,
+        Err(LikelihoodFailure::OutsideSupport) => f64::NEG_INFINITY,
+        Err(LikelihoodFailure::Numerical) => {
+            failures.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            f64::NEG_INFINITY
+        }
+    }
 }
 
 impl<F: Fn(&[f64]) -> f64 + Sync> LogLikelihood for F {
@@ -100,6 +141,10 @@ pub struct TmcmcResult {
     pub betas: Vec<f64>,
     /// Mean acceptance per stage.
     pub acceptance: Vec<f64>,
+    /// Likelihood evaluations.
+    pub evaluations: usize,
+    /// Of those, numerical failures ([`LikelihoodFailure::Numerical`]), rejected and counted.
+    pub numerical_failures: usize,
 }
 
 impl TmcmcResult {
@@ -161,9 +206,11 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         .into_par_iter()
         .map(|i| prior.sample(&mut stream(options.seed, 0, i)))
         .collect();
+    let failures = std::sync::atomic::AtomicUsize::new(0);
+    let evaluations = std::sync::atomic::AtomicUsize::new(n);
     let mut ln_l: Vec<f64> = theta
         .par_iter()
-        .map(|t| likelihood.ln_likelihood(t))
+        .map(|t| counted_ln_likelihood(likelihood, t, &failures))
         .collect();
     if ln_l.iter().all(|l| !l.is_finite()) {
         return Err(BayesError::Degenerate(
@@ -259,7 +306,8 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
                     if !py.is_finite() {
                         continue;
                     }
-                    let ly = likelihood.ln_likelihood(&y);
+                    evaluations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let ly = counted_ln_likelihood(likelihood, &y, &failures);
                     let log_ratio = py + beta * ly - px - beta * lx;
                     let u: f64 = rand::Rng::random::<f64>(&mut rng);
                     if log_ratio >= 0.0 || u.ln() < log_ratio {
@@ -294,6 +342,8 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         log_evidence,
         betas,
         acceptance,
+        evaluations: evaluations.into_inner(),
+        numerical_failures: failures.into_inner(),
     })
 }
 

@@ -221,3 +221,43 @@ fn mixture_of_narrow_gaussians_evidence() {
         );
     }
 }
+
+/// A likelihood whose solver fails on a band of theta: the failures are counted (never read as
+/// a fit) and points outside the support are not.
+#[test]
+fn numerical_failures_are_counted_apart_from_the_support() {
+    use chatter_bayes::{LikelihoodFailure, LogLikelihood};
+    struct Flaky;
+    impl LogLikelihood for Flaky {
+        fn ln_likelihood(&self, theta: &[f64]) -> f64 {
+            self.try_ln_likelihood(theta).unwrap_or(f64::NEG_INFINITY)
+        }
+        fn try_ln_likelihood(&self, theta: &[f64]) -> Result<f64, LikelihoodFailure> {
+            let t = theta[0];
+            if t > 2.5 {
+                Err(LikelihoodFailure::OutsideSupport)
+            } else if (-2.5..-2.4).contains(&t) {
+                Err(LikelihoodFailure::Numerical)
+            } else {
+                // y = 0.5 observed with unit noise
+                Ok(-0.5 * (0.5 - t).powi(2) - 0.5 * (2.0 * PI).ln())
+            }
+        }
+    }
+    let prior = IndependentPrior::new(vec![Marginal::Normal { mean: 0.0, sd: 1.0 }]).unwrap();
+    let options = TmcmcOptions {
+        samples: 2000,
+        seed: 4,
+        ..TmcmcOptions::default()
+    };
+    let r = tmcmc(&prior, &Flaky, &options, &Silent).unwrap();
+    assert!(r.numerical_failures > 0 && r.numerical_failures < r.evaluations / 50);
+    // the failures hit only the band: with the default reading, -inf would not be counted
+    let counted_without_override = {
+        let plain = |t: &[f64]| Flaky.ln_likelihood(t);
+        tmcmc(&prior, &plain, &options, &Silent)
+            .unwrap()
+            .numerical_failures
+    };
+    assert_eq!(counted_without_override, 0);
+}

@@ -122,6 +122,15 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     ));
     let result = job.run(&options, &progress)?;
     progress.0.finish();
+    for c in &result.classes {
+        if let Some(n) = c.numerical_failures.filter(|&n| n > 0) {
+            let class = c.alpha.map_or(String::new(), |a| format!(" alpha {a}"));
+            eprintln!(
+                "warning: model class{class}: {n} likelihood evaluations failed numerically \
+                 (rejected and counted; see `numerical_failures` in summary.json)"
+            );
+        }
+    }
     write_outputs(&args.out, &result, &model)
 }
 

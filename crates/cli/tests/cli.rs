@@ -370,12 +370,19 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
     ] {
         assert!(out_dir.join(file).exists(), "{file}");
     }
-    let diagnosed = chatter_dynamics::ModalModel::from_path(out_dir.join("diagnosed_model.json"))
-        .unwrap();
+    let diagnosed =
+        chatter_dynamics::ModalModel::from_path(out_dir.join("diagnosed_model.json")).unwrap();
     assert!(diagnosed.process_damping_n_per_m().is_some());
     succeed(
         chatter()
-            .args(["lobes", "--method", "fdm", "--speeds", "3000:4000:3", "--model"])
+            .args([
+                "lobes",
+                "--method",
+                "fdm",
+                "--speeds",
+                "3000:4000:3",
+                "--model",
+            ])
             .arg(out_dir.join("diagnosed_model.json")),
     );
     let full: serde_json::Value =

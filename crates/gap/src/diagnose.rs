@@ -9,7 +9,6 @@ use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
 use crate::shrink::{Shrink, ValidationReport, shrink};
 use crate::variant::Variant;
-use chatter_bayes::Prior;
 use chatter_bayes::tmcmc::{
     Silent, TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, tmcmc,
 };
@@ -265,15 +264,15 @@ impl Fitted<'_> {
         s.iter().step_by(step).take(n).map(Vec::as_slice).collect()
     }
 
-    /// The highest-posterior sample's variant.
-    pub fn mode_variant(&self) -> Option<Variant> {
+    /// The variant at the posterior mean of the sampled parameters (log factors, effect
+    /// parameters).
+    pub fn mean_variant(&self) -> Option<Variant> {
         let s = self.run.samples.samples();
-        let best = s
-            .iter()
-            .zip(&self.run.ln_likelihoods)
-            .map(|(t, l)| (t, l + self.model.prior.ln_pdf(t)))
-            .max_by(|a, b| a.1.total_cmp(&b.1))?;
-        self.model.variant(best.0)
+        let n = s.first()?.len();
+        let mean: Vec<f64> = (0..n)
+            .map(|k| s.iter().map(|t| t[k]).sum::<f64>() / s.len() as f64)
+            .collect();
+        self.model.variant(&mean)
     }
 }
 
@@ -411,7 +410,7 @@ pub struct Diagnosis {
 }
 
 /// Residuals against the nominal model and against the diagnosed one (the best class at its
-/// highest-posterior sample).
+/// posterior mean).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ResidualPair {
     /// Against the nominal model.
@@ -460,8 +459,8 @@ impl Diagnosis {
             .collect()
     }
 
-    /// The diagnosed machine: the verdict's class at its highest-posterior sample (the
-    /// nominal model for `consistent`), as a model file at campaign start and zero speed.
+    /// The diagnosed machine: the best class at its posterior mean (the nominal model for
+    /// `consistent`), as a model at campaign start and zero speed.
     pub fn diagnosed_model(&self) -> &ModalModel {
         &self.diagnosed.model
     }
@@ -573,7 +572,7 @@ pub fn diagnose(
         nominal_variant.clone()
     } else {
         fitted[best]
-            .mode_variant()
+            .mean_variant()
             .unwrap_or_else(|| nominal_variant.clone())
     };
     let residual_pair = ResidualPair {

@@ -51,6 +51,9 @@ pub struct Posterior {
     pub log_evidence: f64,
     /// E[ln p(D | theta, M)] over the posterior (TMCMC only): the data fit of Eq. 33.
     pub data_fit: Option<f64>,
+    /// Likelihood evaluations that failed numerically (TMCMC only): rejected and counted,
+    /// never read as a fit or as "stable".
+    pub numerical_failures: Option<usize>,
 }
 
 /// Progress of class selection; no-op by default. The sampler stages arrive through the
@@ -94,6 +97,7 @@ pub fn sample_posterior<P: Prior, L: LogLikelihood>(
                 data_fit: Some(run.data_fit()),
                 log_evidence: run.log_evidence,
                 samples: run.samples,
+                numerical_failures: Some(run.numerical_failures),
             })
         }
         Sampler::Amcmc => {
@@ -131,6 +135,7 @@ pub fn sample_posterior<P: Prior, L: LogLikelihood>(
                 samples: chain.samples,
                 log_evidence: kept.log_mean_likelihood,
                 data_fit: None,
+                numerical_failures: None,
             })
         }
     }

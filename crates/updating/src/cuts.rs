@@ -17,6 +17,7 @@
 use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
+use chatter_bayes::LikelihoodFailure;
 use chatter_dynamics::Cut;
 use chatter_stability::boundary::LobePoint;
 
@@ -138,25 +139,35 @@ impl CutsLikelihood {
     }
 
     /// ln prod_i P(a_i | theta) (004 Eq. 7 without the prior); -inf where the model cannot be
-    /// built or its boundary fails.
+    /// built or its boundary fails (see [`Self::try_ln_likelihood`] for which).
     pub fn ln_likelihood(&self, theta: &[f64]) -> f64 {
-        let Ok(model) = self.parameterization.model(theta) else {
-            return f64::NEG_INFINITY;
-        };
-        let Ok(boundaries) = limiting_depths(&model, &self.speeds_rpm, &self.options) else {
-            return f64::NEG_INFINITY;
-        };
-        self.cuts
+        self.try_ln_likelihood(theta).unwrap_or(f64::NEG_INFINITY)
+    }
+
+    /// ln prod_i P(a_i | theta), or why there is none: outside the support where the
+    /// parameters make no valid model, numerical where the boundary solver fails.
+    pub fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
+        let model = self
+            .parameterization
+            .model(theta)
+            .map_err(|_| LikelihoodFailure::OutsideSupport)?;
+        let boundaries = limiting_depths(&model, &self.speeds_rpm, &self.options)
+            .map_err(|_| LikelihoodFailure::Numerical)?;
+        Ok(self
+            .cuts
             .iter()
             .zip(&self.speed_of)
             .map(|(c, &k)| self.kernel.ln_likelihood(c, &boundaries[k]))
-            .sum()
+            .sum())
     }
 }
 
 impl chatter_bayes::LogLikelihood for CutsLikelihood {
     fn ln_likelihood(&self, theta: &[f64]) -> f64 {
         CutsLikelihood::ln_likelihood(self, theta)
+    }
+    fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
+        CutsLikelihood::try_ln_likelihood(self, theta)
     }
 }
 

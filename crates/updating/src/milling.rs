@@ -22,6 +22,7 @@
 
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
+use chatter_bayes::LikelihoodFailure;
 use chatter_dynamics::{ModalModel, Operation, PoleObservation};
 use chatter_stability::DominantMultiplier;
 use chatter_stability::monodromy::Discretization;
@@ -158,17 +159,27 @@ impl MillingPoleLikelihood {
             .collect()
     }
 
-    /// ln p(D | theta, M(alpha)) (Eq. 15); -inf where the model cannot be built.
+    /// ln p(D | theta, M(alpha)) (Eq. 15); -inf where the model cannot be built or its
+    /// multipliers cannot be computed (see [`Self::try_ln_likelihood`] for which).
     pub fn ln_likelihood(&self, theta: &[f64]) -> f64 {
+        self.try_ln_likelihood(theta).unwrap_or(f64::NEG_INFINITY)
+    }
+
+    /// ln p(D | theta, M(alpha)) (Eq. 15), or why there is none: outside the support where
+    /// the parameters make no valid model, numerical where the monodromy solver fails.
+    pub fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
         let Some((&var_w, theta_m)) = theta.split_last() else {
-            return f64::NEG_INFINITY;
+            return Err(LikelihoodFailure::OutsideSupport);
         };
         if var_w.is_nan() || var_w <= 0.0 || theta_m.len() != self.parameterization.dimension() {
-            return f64::NEG_INFINITY;
+            return Err(LikelihoodFailure::OutsideSupport);
         }
-        let Ok(predicted) = self.predicted_poles(theta_m) else {
-            return f64::NEG_INFINITY;
-        };
+        if self.parameterization.model(theta_m).is_err() {
+            return Err(LikelihoodFailure::OutsideSupport);
+        }
+        let predicted = self
+            .predicted_poles(theta_m)
+            .map_err(|_| LikelihoodFailure::Numerical)?;
         let var_z = self.alpha * self.alpha * var_w;
         let j: f64 = self
             .conditions
@@ -180,13 +191,20 @@ impl MillingPoleLikelihood {
             })
             .sum();
         let l = -0.5 * j - self.poles * (2.0 * PI * (var_w * var_z).sqrt()).ln();
-        if l.is_nan() { f64::NEG_INFINITY } else { l }
+        if l.is_nan() {
+            Err(LikelihoodFailure::Numerical)
+        } else {
+            Ok(l)
+        }
     }
 }
 
 impl chatter_bayes::LogLikelihood for MillingPoleLikelihood {
     fn ln_likelihood(&self, theta: &[f64]) -> f64 {
         MillingPoleLikelihood::ln_likelihood(self, theta)
+    }
+    fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
+        MillingPoleLikelihood::try_ln_likelihood(self, theta)
     }
 }
 

@@ -32,6 +32,7 @@
 
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
+use chatter_bayes::LikelihoodFailure;
 use chatter_dynamics::{ModalModel, Operation, PoleObservation};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -422,28 +423,44 @@ impl TurningPoleLikelihood {
     }
 
     /// ln p(D | theta, M(alpha)) (Eq. 31); -inf where the model cannot be built or has no root
-    /// near the identified poles.
+    /// near the identified poles (see [`Self::try_ln_likelihood`] for which).
     pub fn ln_likelihood(&self, theta: &[f64]) -> f64 {
+        self.try_ln_likelihood(theta).unwrap_or(f64::NEG_INFINITY)
+    }
+
+    /// ln p(D | theta, M(alpha)) (Eq. 31), or why there is none: outside the support where the
+    /// parameters make no valid model, numerical where the root solver fails.
+    pub fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
         let Some((&var_r, theta_m)) = theta.split_last() else {
-            return f64::NEG_INFINITY;
+            return Err(LikelihoodFailure::OutsideSupport);
         };
         if var_r.is_nan() || var_r <= 0.0 || theta_m.len() != self.parameterization.dimension() {
-            return f64::NEG_INFINITY;
+            return Err(LikelihoodFailure::OutsideSupport);
         }
-        let Ok(res) = self.normalized_residuals(theta_m) else {
-            return f64::NEG_INFINITY;
-        };
+        if self.parameterization.model(theta_m).is_err() {
+            return Err(LikelihoodFailure::OutsideSupport);
+        }
+        let res = self
+            .normalized_residuals(theta_m)
+            .map_err(|_| LikelihoodFailure::Numerical)?;
         let var_i = self.alpha * var_r;
         let n = res.len() as f64;
         let chi2: f64 = res.iter().map(|(r, i)| r * r / var_r + i * i / var_i).sum();
         let l = -0.5 * chi2 - n * (2.0 * PI * (var_r * var_i).sqrt()).ln();
-        if l.is_nan() { f64::NEG_INFINITY } else { l }
+        if l.is_nan() {
+            Err(LikelihoodFailure::Numerical)
+        } else {
+            Ok(l)
+        }
     }
 }
 
 impl chatter_bayes::LogLikelihood for TurningPoleLikelihood {
     fn ln_likelihood(&self, theta: &[f64]) -> f64 {
         TurningPoleLikelihood::ln_likelihood(self, theta)
+    }
+    fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {
+        TurningPoleLikelihood::try_ln_likelihood(self, theta)
     }
 }
 

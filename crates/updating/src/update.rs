@@ -69,6 +69,9 @@ pub struct ClassSummary {
     pub log_evidence: f64,
     /// p(M | D).
     pub probability: f64,
+    /// Likelihood evaluations of the sampler that failed numerically (iTMCMC / TMCMC).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub numerical_failures: Option<usize>,
 }
 
 /// The result of a job.
@@ -210,6 +213,7 @@ impl UpdateJob {
                     alpha: None,
                     log_evidence: post.log_evidence,
                     probability: 1.0,
+                    numerical_failures: post.numerical_failures,
                 };
                 (post.samples, vec![class], None)
             }
@@ -268,6 +272,7 @@ fn summarize(
             alpha: Some(c.alpha),
             log_evidence: c.posterior.log_evidence,
             probability,
+            numerical_failures: c.posterior.numerical_failures,
         })
         .collect();
     let selected = selection.selected_class();
