@@ -100,27 +100,36 @@ impl MeasuredLobeTable {
         let mut out = Vec::new();
         // (w tau - eps) / 2 pi: lobe k crosses where it equals k
         let p = |hz: f64, eps: f64| (2.0 * PI * hz * tau_s - eps) / (2.0 * PI);
+        let hz = |k: usize, t: f64| f[k] + t * (f[k + 1] - f[k]);
+        // the phase where a lobe begins or ends (Re Lambda = 0): the end of (0, 2 pi) nearer
+        let edge = |eps: f64| if eps > PI { 2.0 * PI } else { 0.0 };
         for branch in 0..2 {
             for k in 0..f.len() - 1 {
-                let (Some(l0), Some(l1)) =
-                    (self.pairs[k].lobe(branch), self.pairs[k + 1].lobe(branch))
-                else {
-                    continue;
-                };
-                if (l1.eps - l0.eps).abs() > PI {
-                    continue;
-                }
-                let (p0, p1) = (p(f[k], l0.eps), p(f[k + 1], l1.eps));
+                let (span, boundary_at_start) =
+                    match (self.pairs[k].lobe(branch), self.pairs[k + 1].lobe(branch)) {
+                        (Some(l0), Some(l1)) if (l1.eps - l0.eps).abs() <= PI => {
+                            ((0.0, l0.eps, 1.0, l1.eps), None)
+                        }
+                        (None, Some(l1)) => {
+                            let tb = self.boundary(k, branch, false);
+                            ((tb, edge(l1.eps), 1.0, l1.eps), Some(true))
+                        }
+                        (Some(l0), None) => {
+                            let tb = self.boundary(k, branch, true);
+                            ((0.0, l0.eps, tb, edge(l0.eps)), Some(false))
+                        }
+                        _ => continue,
+                    };
+                let (t0, e0, t1, e1) = span;
+                let (p0, p1) = (p(hz(k, t0), e0), p(hz(k, t1), e1));
                 let (lo, hi) = (p0.min(p1), p0.max(p1));
-                let first = lo.ceil().max(0.0);
-                let mut m = first;
+                let mut m = lo.ceil().max(0.0);
                 while m <= hi {
-                    if m == p1 && k + 2 < f.len() {
-                        // counted on the next step
-                        m += 1.0;
-                        continue;
-                    }
-                    if let Some(c) = self.bisect(k, branch, m, p0 < p1, &p) {
+                    // a crossing exactly at a sample is counted on the step that starts there
+                    if !(m == p1 && t1 == 1.0 && k + 2 < f.len())
+                        && let Some(c) =
+                            self.bisect(k, branch, m, (t0, t1), (p0 < p1, boundary_at_start), &p)
+                    {
                         out.push(c);
                     }
                     m += 1.0;
@@ -130,21 +139,47 @@ impl MeasuredLobeTable {
         out
     }
 
-    /// The crossing of integer `m` by p(t) on step `k`, increasing or not.
+    /// Where on step `k` eigenvalue `branch` stops (`lobe_at_start`) or starts being a lobe.
+    fn boundary(&self, k: usize, branch: usize, lobe_at_start: bool) -> f64 {
+        let (mut a, mut b) = (0.0, 1.0);
+        for _ in 0..BISECTION_STEPS {
+            let t = 0.5 * (a + b);
+            let is_lobe = self.branch_at(k, t, branch).1.is_some();
+            if is_lobe == lobe_at_start {
+                a = t;
+            } else {
+                b = t;
+            }
+        }
+        if lobe_at_start { a } else { b }
+    }
+
+    /// The crossing of integer `m` by p(t) on `span` of step `k`; `direction` holds whether p
+    /// increases and, for a span that ends at a lobe boundary, whether that is its start.
     fn bisect(
         &self,
         k: usize,
         branch: usize,
         m: f64,
-        increasing: bool,
+        span: (f64, f64),
+        direction: (bool, Option<bool>),
         p: &impl Fn(f64, f64) -> f64,
     ) -> Option<(f64, f64)> {
-        let (mut a, mut b) = (0.0, 1.0);
+        let (increasing, boundary_at_start) = direction;
+        let (mut a, mut b) = span;
         let mut last = None;
         for _ in 0..BISECTION_STEPS {
             let t = 0.5 * (a + b);
             let (hz, lobe) = self.branch_at(k, t, branch);
-            let (eps, depth) = lobe?;
+            let Some((eps, depth)) = lobe else {
+                // only next to a lobe boundary: step away from it
+                match boundary_at_start {
+                    Some(true) => a = t,
+                    Some(false) => b = t,
+                    None => return None,
+                }
+                continue;
+            };
             last = Some((depth, hz));
             if (p(hz, eps) < m) == increasing {
                 a = t;
