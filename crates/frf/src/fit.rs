@@ -30,6 +30,13 @@ use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
+/// Clusters seen in fewer orders than this share are never added as modes.
+const MIN_SPARE_SHARE: f64 = 0.1;
+/// Most modes added where the fit misses most.
+const MAX_RESIDUAL_MODES: usize = 4;
+/// Most clusters tried beyond those that pass `min_share`.
+const MAX_SPARE_TRIALS: usize = 12;
+
 /// Options of [`fit_modes`], with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
@@ -37,12 +44,13 @@ pub struct FitOptions {
     pub max_order: usize,
     /// Number of modes; None picks it from the stabilization diagram (default).
     pub modes: Option<usize>,
-    /// Relative frequency change of a stable pole between orders; default 0.01.
+    /// Relative frequency change of a stable pole between orders; default 0.02.
     pub frequency_tolerance: f64,
-    /// Relative damping change of a stable pole between orders; default 0.05.
+    /// Relative damping change of a stable pole between orders; default 0.3 (LSCF damping
+    /// scatters with noise; the chosen poles are refined by nonlinear least squares after).
     pub damping_tolerance: f64,
     /// Share of the orders in which a cluster of stable poles must appear to count as a mode;
-    /// default 0.4.
+    /// default 0.3.
     pub min_share: f64,
     /// Residual terms for out-of-band modes; default [`Residuals::UpperAndLower`].
     pub residuals: Residuals,
@@ -53,9 +61,9 @@ impl Default for FitOptions {
         Self {
             max_order: 40,
             modes: None,
-            frequency_tolerance: 0.01,
-            damping_tolerance: 0.05,
-            min_share: 0.4,
+            frequency_tolerance: 0.02,
+            damping_tolerance: 0.3,
+            min_share: 0.3,
             residuals: Residuals::UpperAndLower,
         }
     }
@@ -278,6 +286,111 @@ fn residues(
     Some(sol.iter().zip(&norms).map(|(v, n)| v / n).collect())
 }
 
+/// The residual vector (fit minus data, real and imaginary parts) of the best residues for
+/// `poles`.
+fn misfit_vector(
+    x: &[f64],
+    h: &[Complex64],
+    poles: &[Complex64],
+    residual_columns: usize,
+) -> Option<DVector<f64>> {
+    let c = residues(x, h, poles, true, residual_columns)?;
+    let mut r = DVector::<f64>::zeros(2 * x.len());
+    for (k, (&f, &hk)) in x.iter().zip(h).enumerate() {
+        let w = 2.0 * PI * f;
+        let iw = Complex64::new(0.0, w);
+        let mut g = Complex64::new(0.0, 0.0);
+        for (n, &s) in poles.iter().enumerate() {
+            let a = Complex64::new(c[2 * n], c[2 * n + 1]);
+            g += a / (iw - s) + a.conj() / (iw - s.conj());
+        }
+        let base = 2 * poles.len();
+        if residual_columns >= 1 {
+            g += c[base];
+        }
+        if residual_columns >= 2 {
+            g -= c[base + 1] / (w * w);
+        }
+        r[2 * k] = g.re - hk.re;
+        r[2 * k + 1] = g.im - hk.im;
+    }
+    Some(r)
+}
+
+/// Poles from (ln f, ln zeta) per mode.
+fn poles_of(theta: &[f64]) -> Vec<Complex64> {
+    theta
+        .chunks(2)
+        .map(|c| {
+            let (w, z) = (2.0 * PI * c[0].exp(), c[1].exp().min(0.99));
+            Complex64::new(-z * w, w * (1.0 - z * z).sqrt())
+        })
+        .collect()
+}
+
+/// Levenberg-Marquardt on the frequencies and damping ratios (log scale) with the residues
+/// and residual terms eliminated by linear least squares (variable projection), from the
+/// stabilization-diagram estimates.
+fn refine(
+    x: &[f64],
+    h: &[Complex64],
+    modes: &[(f64, f64)],
+    residual_columns: usize,
+) -> Vec<(f64, f64)> {
+    let mut theta: Vec<f64> = modes.iter().flat_map(|&(f, z)| [f.ln(), z.ln()]).collect();
+    let cost =
+        |t: &[f64]| misfit_vector(x, h, &poles_of(t), residual_columns).map(|r| r.norm_squared());
+    let Some(mut current) = cost(&theta) else {
+        return modes.to_vec();
+    };
+    let mut lambda = 1e-3;
+    for _ in 0..25 {
+        let Some(r0) = misfit_vector(x, h, &poles_of(&theta), residual_columns) else {
+            break;
+        };
+        let p = theta.len();
+        let mut jac = DMatrix::<f64>::zeros(r0.len(), p);
+        for j in 0..p {
+            let step = if j % 2 == 0 { 1e-7 } else { 1e-5 };
+            let mut t = theta.clone();
+            t[j] += step;
+            let Some(r) = misfit_vector(x, h, &poles_of(&t), residual_columns) else {
+                return modes.to_vec();
+            };
+            jac.set_column(j, &((r - &r0) / step));
+        }
+        let jtj = jac.transpose() * &jac;
+        let jtr = jac.transpose() * &r0;
+        let mut improved = false;
+        for _ in 0..10 {
+            let mut a = jtj.clone();
+            for j in 0..p {
+                a[(j, j)] += lambda * jtj[(j, j)].max(1e-30);
+            }
+            let Some(delta) = a.lu().solve(&(-&jtr)) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let trial: Vec<f64> = theta.iter().zip(delta.iter()).map(|(t, d)| t + d).collect();
+            match cost(&trial) {
+                Some(c) if c < current => {
+                    let gain = (current - c) / current;
+                    theta = trial;
+                    current = c;
+                    lambda = (lambda * 0.3).max(1e-9);
+                    improved = gain > 1e-10;
+                    break;
+                }
+                _ => lambda *= 10.0,
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    theta.chunks(2).map(|c| (c[0].exp(), c[1].exp())).collect()
+}
+
 /// Fit modes to `frf` over [`fmin_hz`, `fmax_hz`].
 pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) -> Result<ModalFit> {
     if !(options.max_order >= 2 && options.max_order <= 200) {
@@ -392,12 +505,11 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         })
         .collect();
     candidates.sort_by(|a, b| b.2.total_cmp(&a.2));
-    let chosen: Vec<(f64, f64, f64)> = match options.modes {
-        Some(m) => candidates.into_iter().take(m).collect(),
+    let (chosen, spare): (Vec<(f64, f64, f64)>, Vec<(f64, f64, f64)>) = match options.modes {
+        Some(m) => (candidates.into_iter().take(m).collect(), Vec::new()),
         None => candidates
             .into_iter()
-            .filter(|c| c.2 >= options.min_share)
-            .collect(),
+            .partition(|c| c.2 >= options.min_share),
     };
     if chosen.is_empty() {
         return Err(FrfError::Fit(format!(
@@ -411,6 +523,14 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         Residuals::UpperAndLower if x[0] > 0.0 => 2,
         Residuals::UpperAndLower => 1,
     };
+    let refined = |chosen: &[(f64, f64, f64)]| -> Vec<(f64, f64, f64)> {
+        let start: Vec<(f64, f64)> = chosen.iter().map(|c| (c.0, c.1)).collect();
+        refine(x, &h, &start, residual_columns)
+            .into_iter()
+            .zip(chosen)
+            .map(|((f, z), c)| (f, z, c.2))
+            .collect()
+    };
     let fit = |chosen: &[(f64, f64, f64)]| -> Result<(Vec<f64>, Vec<Complex64>)> {
         let poles: Vec<Complex64> = chosen
             .iter()
@@ -423,8 +543,81 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             .ok_or_else(|| FrfError::Fit("the residue least squares failed".into()))?;
         Ok((c, poles))
     };
+    let mut chosen = refined(&chosen);
+    if options.modes.is_none() {
+        // add less frequent clusters while each cuts the misfit by at least 5 %
+        let misfit = |c: &[(f64, f64, f64)]| {
+            let poles: Vec<Complex64> = c
+                .iter()
+                .map(|m| poles_of(&[m.0.ln(), m.1.ln()])[0])
+                .collect();
+            misfit_vector(x, &h, &poles, residual_columns).map_or(f64::INFINITY, |r| r.norm())
+        };
+        let mut current = misfit(&chosen);
+        for cand in spare
+            .iter()
+            .filter(|c| c.2 >= MIN_SPARE_SHARE)
+            .take(MAX_SPARE_TRIALS)
+        {
+            if chosen
+                .iter()
+                .any(|c| (c.0 - cand.0).abs() <= options.frequency_tolerance * c.0)
+            {
+                continue;
+            }
+            let mut trial = chosen.clone();
+            trial.push(*cand);
+            let trial = refined(&trial);
+            let m = misfit(&trial);
+            if m < 0.95 * current {
+                chosen = trial;
+                current = m;
+            }
+        }
+        // then modes where the fit misses most (a mode the diagram did not stabilize)
+        for _ in 0..MAX_RESIDUAL_MODES {
+            let poles: Vec<Complex64> = chosen
+                .iter()
+                .map(|m| poles_of(&[m.0.ln(), m.1.ln()])[0])
+                .collect();
+            let Some(r) = misfit_vector(x, &h, &poles, residual_columns) else {
+                break;
+            };
+            // residual power smoothed over +-1 % in frequency
+            let power: Vec<f64> = (0..x.len())
+                .map(|k| r[2 * k].powi(2) + r[2 * k + 1].powi(2))
+                .collect();
+            let mut best = (0.0, x[0]);
+            let mut lo = 0;
+            let mut hi = 0;
+            let mut sum = 0.0;
+            for (k, &f) in x.iter().enumerate() {
+                while hi < x.len() && x[hi] <= 1.01 * f {
+                    sum += power[hi];
+                    hi += 1;
+                }
+                while x[lo] < 0.99 * f {
+                    sum -= power[lo];
+                    lo += 1;
+                }
+                if sum > best.0 {
+                    best = (sum, f);
+                }
+                let _ = k;
+            }
+            let mut trial = chosen.clone();
+            trial.push((best.1, 0.03, 0.0));
+            let trial = refined(&trial);
+            let m = misfit(&trial);
+            if m < 0.95 * current {
+                chosen = trial;
+                current = m;
+            } else {
+                break;
+            }
+        }
+    }
     let (mut coeffs, mut poles) = fit(&chosen)?;
-    let mut chosen = chosen;
     if options.modes.is_none() && chosen.len() > 1 {
         // drop modes that contribute under 2 % of the peak receptance, refit once
         let peak = h.iter().map(|v| v.norm()).fold(0.0, f64::max);
@@ -439,7 +632,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             .map(|(_, (c, _))| *c)
             .collect();
         if !keep.is_empty() && keep.len() < chosen.len() {
-            chosen = keep;
+            chosen = refined(&keep);
             (coeffs, poles) = fit(&chosen)?;
         }
     }
