@@ -30,6 +30,9 @@ use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
+/// A candidate mode: frequency (Hz), damping ratio, share of the orders it was stable in.
+type Candidate = (f64, f64, f64);
+
 /// Clusters seen in fewer orders than this share are never added as modes.
 const MIN_SPARE_SHARE: f64 = 0.1;
 /// Most modes added where the fit misses most.
@@ -486,7 +489,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         }
     }
     let total = orders.len().max(1) as f64;
-    let mut candidates: Vec<(f64, f64, f64)> = clusters
+    let mut candidates: Vec<Candidate> = clusters
         .iter()
         .map(|c| {
             let mut ords: Vec<usize> = c.iter().map(|p| p.2).collect();
@@ -505,7 +508,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         })
         .collect();
     candidates.sort_by(|a, b| b.2.total_cmp(&a.2));
-    let (chosen, spare): (Vec<(f64, f64, f64)>, Vec<(f64, f64, f64)>) = match options.modes {
+    let (chosen, spare): (Vec<Candidate>, Vec<Candidate>) = match options.modes {
         Some(m) => (candidates.into_iter().take(m).collect(), Vec::new()),
         None => candidates
             .into_iter()
@@ -523,7 +526,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         Residuals::UpperAndLower if x[0] > 0.0 => 2,
         Residuals::UpperAndLower => 1,
     };
-    let refined = |chosen: &[(f64, f64, f64)]| -> Vec<(f64, f64, f64)> {
+    let refined = |chosen: &[Candidate]| -> Vec<Candidate> {
         let start: Vec<(f64, f64)> = chosen.iter().map(|c| (c.0, c.1)).collect();
         refine(x, &h, &start, residual_columns)
             .into_iter()
@@ -531,7 +534,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             .map(|((f, z), c)| (f, z, c.2))
             .collect()
     };
-    let fit = |chosen: &[(f64, f64, f64)]| -> Result<(Vec<f64>, Vec<Complex64>)> {
+    let fit = |chosen: &[Candidate]| -> Result<(Vec<f64>, Vec<Complex64>)> {
         let poles: Vec<Complex64> = chosen
             .iter()
             .map(|&(f, z, _)| {
@@ -546,7 +549,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
     let mut chosen = refined(&chosen);
     if options.modes.is_none() {
         // add less frequent clusters while each cuts the misfit by at least 5 %
-        let misfit = |c: &[(f64, f64, f64)]| {
+        let misfit = |c: &[Candidate]| {
             let poles: Vec<Complex64> = c
                 .iter()
                 .map(|m| poles_of(&[m.0.ln(), m.1.ln()])[0])
@@ -591,7 +594,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             let mut lo = 0;
             let mut hi = 0;
             let mut sum = 0.0;
-            for (k, &f) in x.iter().enumerate() {
+            for &f in x {
                 while hi < x.len() && x[hi] <= 1.01 * f {
                     sum += power[hi];
                     hi += 1;
@@ -603,7 +606,6 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
                 if sum > best.0 {
                     best = (sum, f);
                 }
-                let _ = k;
             }
             let mut trial = chosen.clone();
             trial.push((best.1, 0.03, 0.0));
@@ -621,7 +623,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
     if options.modes.is_none() && chosen.len() > 1 {
         // drop modes that contribute under 2 % of the peak receptance, refit once
         let peak = h.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        let keep: Vec<(f64, f64, f64)> = chosen
+        let keep: Vec<Candidate> = chosen
             .iter()
             .zip(&poles)
             .enumerate()
