@@ -197,8 +197,11 @@ fn load_and_compute(
     observations: Option<&Path>,
     quiet: bool,
 ) -> Result<(Option<Observations>, Vec<LobePoint>)> {
-    let model = inputs::model(model_path)?;
     let obs = observations.map(inputs::observations).transpose()?;
+    if let Some(lobes) = crate::measured::lobes(model_path, method, speeds)? {
+        return Ok((obs, lobes));
+    }
+    let model = inputs::model(model_path)?;
     let speeds = match speeds {
         Some(s) => inputs::speeds(s)?,
         None => default_speeds(&model),

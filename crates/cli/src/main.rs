@@ -5,6 +5,7 @@ mod bands;
 mod commands;
 mod diagnose;
 mod inputs;
+mod measured;
 mod oma;
 mod output;
 mod plan;
@@ -239,6 +240,9 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Modal fit of a measured FRF (LSCF, stabilization, residual terms): model file, JSON
+    /// report on stdout, overlay plot.
+    FitFrf(measured::FitFrfArgs),
     /// Run the main job on the embedded examples and write the results to a folder.
     Demo {
         /// Output folder.
@@ -406,6 +410,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out.as_deref(),
             plot.as_deref(),
         ),
+        Command::FitFrf(args) => measured::fit_frf(&args),
         Command::Demo { out } => commands::demo(&out, quiet),
     }
 }

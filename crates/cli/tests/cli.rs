@@ -715,3 +715,119 @@ fn oma_identifies_the_signals_of_an_observations_file() {
         );
     }
 }
+
+fn real_data(path: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/real"
+    ))
+    .join(path);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipped: {} is absent", p.display());
+        None
+    }
+}
+
+#[test]
+fn lobes_zoa_from_measured_frf_and_clear_error_for_other_methods() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = succeed(
+        chatter()
+            .arg("frf")
+            .arg("--model")
+            .arg(example("schmitz2023_milling_model.json"))
+            .args(["--fmin-hz", "0", "--fmax-hz", "2500", "--points", "2501"]),
+    );
+    std::fs::write(dir.path().join("xx.csv"), &csv).unwrap();
+    let model = dir.path().join("measured.json");
+    std::fs::write(
+        &model,
+        r#"{"operation": {"kind": "milling", "teeth": 4, "radial_immersion": 0.2, "direction": "down"},
+            "cutting": {"ks_n_per_mm2": 750, "beta_deg": 68},
+            "measured_frf": [{"file": "xx.csv", "direction": "x"}, {"file": "xx.csv", "direction": "y"}]}"#,
+    )
+    .unwrap();
+    let measured = succeed(
+        chatter()
+            .args([
+                "lobes",
+                "--method",
+                "zoa",
+                "--speeds",
+                "4000:12000:5",
+                "--model",
+            ])
+            .arg(&model),
+    );
+    let modal = succeed(
+        chatter()
+            .args([
+                "lobes",
+                "--method",
+                "zoa",
+                "--speeds",
+                "4000:12000:5",
+                "--model",
+            ])
+            .arg(example("schmitz2023_milling_model.json")),
+    );
+    let depths = |t: &str| -> Vec<f64> {
+        t.lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+            .collect()
+    };
+    for (a, b) in depths(&measured).iter().zip(depths(&modal)) {
+        assert!((a / b - 1.0).abs() < 5e-3, "{a} vs {b}");
+    }
+    let err = fail(
+        chatter()
+            .args(["lobes", "--method", "fdm", "--model"])
+            .arg(&model),
+    );
+    assert!(
+        err.contains("--method zoa") && err.contains("fit-frf"),
+        "{err}"
+    );
+}
+
+#[test]
+fn fit_frf_writes_a_model_and_a_plot_for_the_real_tap_test() {
+    let Some(frf) =
+        real_data("tap_test_tool_holder/ExperimentalModalAnalysis_Point_1_Channel_1_CH1.txt")
+    else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (out, plot) = (dir.path().join("fitted.json"), dir.path().join("fit.svg"));
+    let report = succeed(
+        chatter()
+            .arg("fit-frf")
+            .arg("--frf")
+            .arg(&frf)
+            .args(["--fmin-hz", "300", "--fmax-hz", "3500", "--model"])
+            .arg(example("schmitz2023_milling_model.json"))
+            .arg("--out")
+            .arg(&out)
+            .arg("--plot")
+            .arg(&plot),
+    );
+    let r: serde_json::Value = serde_json::from_str(&report).unwrap();
+    assert!(
+        r["nrmse_complex_modes_with_residuals"].as_f64().unwrap() < 0.08,
+        "{report}"
+    );
+    succeed(chatter().arg("check").arg("--model").arg(&out));
+    assert!(std::fs::read_to_string(&plot).unwrap().contains("<svg"));
+    let err = fail(
+        chatter()
+            .arg("fit-frf")
+            .arg("--frf")
+            .arg(&frf)
+            .args(["--fmin-hz", "3500", "--fmax-hz", "300", "--out"])
+            .arg(&out),
+    );
+    assert!(err.contains("fmax_hz"), "{err}");
+}

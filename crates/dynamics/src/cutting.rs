@@ -63,28 +63,7 @@ impl ModalModel {
 
     /// The average of H(t) over one delay: exact integral for milling, K_c for turning (N/m^2).
     pub fn average_directional_matrix(&self) -> Matrix2<f64> {
-        let cutting = self.cutting();
-        match self.operation() {
-            Operation::Turning(_) => turning_matrix(cutting),
-            Operation::Milling(m) => {
-                let (kt, kn) = (cutting.kt_n_per_m2(), cutting.kn_n_per_m2());
-                let (a, b) = m.entry_exit_rad();
-                // antiderivatives of sin*cos, sin^2, cos^2
-                let sc = |p: f64| 0.5 * p.sin().powi(2);
-                let ss = |p: f64| 0.5 * p - 0.25 * (2.0 * p).sin();
-                let cc = |p: f64| 0.5 * p + 0.25 * (2.0 * p).sin();
-                let i_sc = sc(b) - sc(a);
-                let i_ss = ss(b) - ss(a);
-                let i_cc = cc(b) - cc(a);
-                let f = m.teeth() as f64 / (2.0 * PI);
-                Matrix2::new(
-                    f * (kt * i_sc + kn * i_ss),
-                    f * (kt * i_cc + kn * i_sc),
-                    f * (-kt * i_ss + kn * i_sc),
-                    f * (-kt * i_sc + kn * i_cc),
-                )
-            }
-        }
+        average_directional_matrix(self.operation(), self.cutting())
     }
 
     /// Process-damping coefficient per unit chip width and velocity, C / V (N s/m^3), at
@@ -121,6 +100,36 @@ impl ModalModel {
                     })
                     .sum()
             }
+        }
+    }
+}
+
+/// The average of H(t) over one delay for `operation` and `cutting` (N/m^2): the exact integral
+/// (N / 2 pi) int_{entry}^{exit} h(phi) dphi for milling, K_c for turning. The matrix of the
+/// zero-order method, for modal and measured-FRF models alike.
+pub fn average_directional_matrix(
+    operation: &Operation,
+    cutting: CuttingCoefficients,
+) -> Matrix2<f64> {
+    match operation {
+        Operation::Turning(_) => turning_matrix(cutting),
+        Operation::Milling(m) => {
+            let (kt, kn) = (cutting.kt_n_per_m2(), cutting.kn_n_per_m2());
+            let (a, b) = m.entry_exit_rad();
+            // antiderivatives of sin*cos, sin^2, cos^2
+            let sc = |p: f64| 0.5 * p.sin().powi(2);
+            let ss = |p: f64| 0.5 * p - 0.25 * (2.0 * p).sin();
+            let cc = |p: f64| 0.5 * p + 0.25 * (2.0 * p).sin();
+            let i_sc = sc(b) - sc(a);
+            let i_ss = ss(b) - ss(a);
+            let i_cc = cc(b) - cc(a);
+            let f = m.teeth() as f64 / (2.0 * PI);
+            Matrix2::new(
+                f * (kt * i_sc + kn * i_ss),
+                f * (kt * i_cc + kn * i_sc),
+                f * (-kt * i_ss + kn * i_sc),
+                f * (-kt * i_sc + kn * i_cc),
+            )
         }
     }
 }

@@ -20,11 +20,76 @@ pub struct ModelFile {
     pub operation: OperationFile,
     /// Cutting coefficients.
     pub cutting: CuttingFile,
-    /// Structural modes.
+    /// Structural modes (may be empty when `measured_frf` gives the dynamics).
+    #[serde(default)]
     pub modes: Vec<ModeFile>,
     /// Optional process damping.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub process_damping: Option<ProcessDampingFile>,
+    /// Measured receptances that give the dynamics instead of (or beside) `modes`; read by
+    /// `chatter-frf`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_frf: Option<Vec<MeasuredFrfFile>>,
+}
+
+/// One entry of `measured_frf`: a measured FRF file and the coordinates it relates.
+///
+/// `direction: "x"` is the direct receptance G_xx; `directions: ["x", "y"]` the cross receptance
+/// G_xy (response x, force y), also used for G_yx unless that is given too.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeasuredFrfFile {
+    /// The FRF file, relative to the model file: `.csv` (`frequency_hz,real_m_per_n,
+    /// imag_m_per_n`), `.uff`/`.unv` (dataset 58), `.frf` (CutPro) or `.txt` (three columns).
+    pub file: std::path::PathBuf,
+    /// Coordinate of a direct FRF (`x`, `y`, `feed`, `cutting`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<String>,
+    /// Response and force coordinates of a cross FRF.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub directions: Option<[String; 2]>,
+    /// Which dataset 58 of a universal file (0-based, counting dataset-58 records only);
+    /// default the first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dataset: Option<usize>,
+    /// Lowest frequency used (Hz), e.g. above a tap test's low-frequency artefacts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fmin_hz: Option<f64>,
+    /// Highest frequency used (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fmax_hz: Option<f64>,
+}
+
+impl MeasuredFrfFile {
+    /// The (response, force) coordinate indices of entry `index` in `operation`.
+    pub fn coordinates(&self, index: usize, operation: &Operation) -> Result<(usize, usize)> {
+        let field = |f: &str| format!("measured_frf[{index}].{f}");
+        let coordinate = |name: &str, f: &str| {
+            operation.coordinate_index(name).ok_or_else(|| {
+                let names: Vec<_> = operation.coordinates().iter().map(|c| c.name()).collect();
+                DynamicsError::invalid(
+                    field(f),
+                    format!(
+                        "`{name}` is not a coordinate of this operation; expected one of {names:?}"
+                    ),
+                )
+            })
+        };
+        match (&self.direction, &self.directions) {
+            (Some(d), None) => {
+                let i = coordinate(d, "direction")?;
+                Ok((i, i))
+            }
+            (None, Some([r, f])) => {
+                Ok((coordinate(r, "directions")?, coordinate(f, "directions")?))
+            }
+            _ => Err(DynamicsError::invalid(
+                field("direction"),
+                "expected either `direction` (direct FRF) or `directions` [response, force] \
+                 (cross FRF)",
+            )),
+        }
+    }
 }
 
 /// `operation` object.
@@ -262,10 +327,23 @@ impl ModeFile {
 }
 
 impl ModelFile {
+    /// The validated operation and cutting coefficients alone (what a measured-FRF model needs
+    /// besides its receptances).
+    pub fn validate_process(&self) -> Result<(Operation, CuttingCoefficients)> {
+        Ok((self.operation.validate()?, self.cutting.validate()?))
+    }
+
     /// Validate into a [`ModalModel`] (SI units inside).
     pub fn validate(&self) -> Result<ModalModel> {
-        let operation = self.operation.validate()?;
-        let cutting = self.cutting.validate()?;
+        let (operation, cutting) = self.validate_process()?;
+        if self.modes.is_empty() && self.measured_frf.is_some() {
+            return Err(DynamicsError::invalid(
+                "modes",
+                "missing: this model gives its dynamics as `measured_frf` only; the zero-order \
+                 method works on it directly (`chatter lobes --method zoa`), other methods need \
+                 modes (fit them with `chatter fit-frf`)",
+            ));
+        }
         let modes = self
             .modes
             .iter()
@@ -353,6 +431,7 @@ impl ModelFile {
             process_damping: model
                 .process_damping_n_per_m()
                 .map(|c| ProcessDampingFile { c_n_per_m: c }),
+            measured_frf: None,
         }
     }
 }

@@ -33,10 +33,12 @@
 //! ```
 
 mod damped;
+mod measured;
 mod system;
 mod table;
 
 pub use damped::ProcessDampedTable;
+pub use measured::{MeasuredLobeTable, measured_limiting_depths};
 pub use system::{ModalTerm, OrientedSystem};
 pub use table::LobeTable;
 

@@ -208,7 +208,7 @@ impl OrientedSystem {
 /// The principal square root of `z` in Cartesian form, sqrt(z) = t + i b / (2 t) with
 /// t = sqrt((|z| + Re z) / 2) (mirrored for Re z < 0), which avoids the polar form's
 /// trigonometric functions.
-fn principal_sqrt(z: Complex64) -> Complex64 {
+pub(crate) fn principal_sqrt(z: Complex64) -> Complex64 {
     // |z| without hypot's care for overflow, unless it is needed
     let modulus = match z.norm_sqr().sqrt() {
         m if m.is_finite() && m > f64::MIN_POSITIVE => m,
