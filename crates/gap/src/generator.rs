@@ -556,7 +556,7 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
     let truth = true_variant(nominal, scenario)?;
     let (lo, hi) = scenario.speed_range_rpm;
     positive("speed_range_rpm.0", lo)?;
-    if !(hi >= lo) {
+    if hi.is_nan() || hi < lo {
         return Err(GapError::InvalidInput {
             field: "speed_range_rpm.1".into(),
             value: hi,
