@@ -35,6 +35,7 @@ pub mod model_file;
 pub mod observations;
 pub mod operation;
 pub mod perturbation;
+mod resample;
 pub mod simulate;
 
 pub use error::{DynamicsError, Result};
