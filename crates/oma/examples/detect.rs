@@ -15,7 +15,14 @@ fn main() {
         "/../../../shared/data/real/milling_chatter_record/test255_accelY.csv"
     );
     if let Ok(s) = Signals::from_csv(std::path::Path::new(real), 10_000.0) {
-        let d = detect(&s, &DetectionOptions::new(5000.0 / 60.0)).unwrap();
+        let mut o = DetectionOptions::new(5000.0 / 60.0);
+        let d0 = detect(&s, &o).unwrap();
+        println!(
+            "test255 without mains: {:?} {:?} {:?}",
+            d0.verdict, d0.chatter_hz, d0.evidence
+        );
+        o.interference_hz = vec![50.0];
+        let d = detect(&s, &o).unwrap();
         println!(
             "test255: {:?} {:?} {:?}",
             d.verdict, d.chatter_hz, d.evidence
