@@ -308,3 +308,29 @@ fn real_record_test255_is_chatter() {
     let off = |base: f64| (f - (f / base).round() * base).abs();
     assert!(off(5000.0 / 60.0) > 2.0 && off(50.0) > 2.0, "{f}");
 }
+
+/// The two MP3 sound clips of the real-data folder decode (symphonia, MP3 feature): 44.1 kHz
+/// stereo, 63.2 s and 9.3 s. Their cutting conditions are not recorded, so no spindle frequency
+/// can be given and no label is asserted (see the note of the signals work).
+#[test]
+fn real_mp3_clips_decode() {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/real/milling_chatter_record/"
+    );
+    for (file, seconds) in [
+        ("combined_chatter6567.mp3", 63.2),
+        ("metalcutting_nochatter8058.mp3", 9.3),
+    ] {
+        let path = std::path::PathBuf::from(dir).join(file);
+        if !path.exists() {
+            eprintln!("skipped: {} is absent", path.display());
+            continue;
+        }
+        let s = Signals::from_mp3(&path).unwrap();
+        assert_eq!(s.sample_rate_hz, 44_100.0);
+        assert_eq!(s.data.len(), 2);
+        let duration = s.data[0].len() as f64 / s.sample_rate_hz;
+        assert!((duration - seconds).abs() < 0.1, "{file}: {duration} s");
+    }
+}
