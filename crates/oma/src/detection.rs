@@ -52,6 +52,7 @@
 use crate::error::{OmaError, Result};
 use crate::signals::Signals;
 use crate::spectrum::{Spectrum, power_spectral_density};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Default largest coefficient of variation of the line's power, over the segments of the
@@ -246,15 +247,22 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     }
     let df = fs / segment as f64;
     let mut psd = vec![0.0; segment / 2 + 1];
-    for ch in &signals.data {
-        let mean = ch.iter().sum::<f64>() / n as f64;
-        let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-        if var <= 0.0 {
-            continue; // a constant channel carries nothing
-        }
-        let scale = 1.0 / var.sqrt();
-        let normalized: Vec<f64> = ch.iter().map(|v| (v - mean) * scale).collect();
-        let s = power_spectral_density(&normalized, fs, segment)?;
+    // channels in parallel, summed in channel order (independent of the thread count)
+    let densities: Vec<Option<Spectrum>> = signals
+        .data
+        .par_iter()
+        .map(|ch| {
+            let mean = ch.iter().sum::<f64>() / n as f64;
+            let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+            if var <= 0.0 {
+                return Ok(None); // a constant channel carries nothing
+            }
+            let scale = 1.0 / var.sqrt();
+            let normalized: Vec<f64> = ch.iter().map(|v| (v - mean) * scale).collect();
+            power_spectral_density(&normalized, fs, segment).map(Some)
+        })
+        .collect::<Result<_>>()?;
+    for s in densities.into_iter().flatten() {
         for (a, b) in psd.iter_mut().zip(&s.values) {
             *a += b;
         }
@@ -451,7 +459,7 @@ fn line_variation(data: &[Vec<f64>], spectrum_segment: usize, peak: usize) -> f6
         })
         .collect();
     let powers: Vec<f64> = starts
-        .iter()
+        .par_iter()
         .map(|&s| {
             let mut total = 0.0;
             let mut energy = 0.0;
