@@ -3,6 +3,7 @@
 
 mod bands;
 mod commands;
+mod detect;
 mod diagnose;
 mod inputs;
 mod measured;
@@ -222,6 +223,9 @@ enum Command {
     Update(update::UpdateArgs),
     /// The next test cut as JSON: value of information (003) or maximum MRR at a risk (004).
     Plan(plan::PlanArgs),
+    /// Stable or chatter, and the chatter frequency, for every signal record (observations
+    /// JSON with one `cuts` entry per record, evidence in its `note`).
+    Detect(detect::DetectArgs),
     /// Operational modal analysis of every signal of an observations file: prints observations
     /// JSON whose `poles` hold the identified dominant poles (modified LSCE with the spindle
     /// harmonics; lifting and polyreference for a milling model).
@@ -399,6 +403,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }),
         Command::Update(args) => update::run(&args, quiet),
         Command::Plan(args) => plan::run(&args, quiet),
+        Command::Detect(args) => detect::run(&args),
         Command::Oma {
             observations,
             model,

@@ -831,3 +831,80 @@ fn fit_frf_writes_a_model_and_a_plot_for_the_real_tap_test() {
     );
     assert!(err.contains("fmax_hz"), "{err}");
 }
+
+/// `chatter detect` on two records written by `chatter simulate` (seed 001's milling example at
+/// 7000 rpm, where the full-discretization limit is 0.97 mm): 0.5 mm is stable, 1.5 mm chatters
+/// near the 760 Hz the lobe diagram gives; the plots are written; a CSV record without its
+/// sample rate is a clear error.
+#[test]
+fn detect_labels_simulated_cuts() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, depth) in [("stable.csv", "0.5"), ("chatter.csv", "1.5")] {
+        succeed(chatter().args([
+            "simulate",
+            "--model",
+            example("schmitz2023_milling_model.json").to_str().unwrap(),
+            "--speed-rpm",
+            "7000",
+            "--depth-mm",
+            depth,
+            "--duration-s",
+            "4",
+            "--sample-rate-hz",
+            "10000",
+            "--seed",
+            "1",
+            "--out",
+            dir.path().join(name).to_str().unwrap(),
+        ]));
+    }
+    let obs = dir.path().join("obs.json");
+    std::fs::write(
+        &obs,
+        r#"{ "signals": [
+            { "file": "stable.csv", "speed_rpm": 7000, "depth_mm": 0.5, "sample_rate_hz": 10000,
+              "once_per_rev_channel": "once_per_rev" },
+            { "file": "chatter.csv", "speed_rpm": 7000, "depth_mm": 1.5, "sample_rate_hz": 10000 }
+        ] }"#,
+    )
+    .unwrap();
+    let plots = dir.path().join("plots");
+    let out = succeed(chatter().args([
+        "detect",
+        "--observations",
+        obs.to_str().unwrap(),
+        "--plot",
+        plots.to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cuts = json["cuts"].as_array().unwrap();
+    assert_eq!(cuts.len(), 2);
+    assert_eq!(cuts[0]["stable"], true, "{out}");
+    assert!(cuts[0].get("chatter_hz").is_none());
+    assert_eq!(cuts[1]["stable"], false, "{out}");
+    let f = cuts[1]["chatter_hz"].as_f64().unwrap();
+    assert!((740.0..790.0).contains(&f), "{f}");
+    assert!(
+        cuts[1]["note"]
+            .as_str()
+            .unwrap()
+            .starts_with("detect chatter.csv: line")
+    );
+    assert!(plots.join("detect-1.svg").exists() && plots.join("detect-2.svg").exists());
+    // the output is an observations file again
+    std::fs::write(dir.path().join("labels.json"), &out).unwrap();
+    succeed(chatter().args([
+        "check",
+        "--model",
+        example("schmitz2023_milling_model.json").to_str().unwrap(),
+        "--observations",
+        dir.path().join("labels.json").to_str().unwrap(),
+    ]));
+    std::fs::write(
+        &obs,
+        r#"{ "signals": [ { "file": "stable.csv", "speed_rpm": 7000, "depth_mm": 0.5 } ] }"#,
+    )
+    .unwrap();
+    let err = fail(chatter().args(["detect", "--observations", obs.to_str().unwrap()]));
+    assert!(err.contains("sample_rate_hz"), "{err}");
+}

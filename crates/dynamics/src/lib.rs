@@ -36,6 +36,7 @@ pub mod observations;
 pub mod operation;
 pub mod perturbation;
 pub mod sampled;
+mod resample;
 pub mod simulate;
 
 pub use error::{DynamicsError, Result};

@@ -17,16 +17,25 @@
 //! S(t) = S(t - tau). Before the first pass the surface is the nominal one of a rigid tool.
 //!
 //! # Forcing and integration
-//! A seeded Gaussian white force (RMS per coordinate, held over each step, so band-limited to
-//! the internal rate) plus optional spindle harmonics acts on both coordinates. Each mode is
-//! advanced with its exact zero-order-hold transition over a step that divides the delay into an
-//! integer number of steps (at least 20 per period of the highest mode and 2 per output sample);
-//! outputs are interpolated linearly to the requested sample rate.
+//! The internal step depends on the dynamics only, never on the output rate
+//! ([`internal_step`]): a whole number of steps per delay (so the surface one delay ago lies on
+//! the grid, with no interpolation), at least [`MIN_STEPS_PER_TOOTH`] of them in milling
+//! ([`MIN_STEPS_PER_DELAY`] in turning) and at least
+//! [`STEPS_PER_MODE_PERIOD`] per period of the highest mode. Each mode is advanced with its exact
+//! transition for a force that varies linearly over the step (first-order hold): the cutting and
+//! harmonic force ramps with the slope of the previous step, except on steps where an edge
+//! entered, left or lost the cut, where it is held. A seeded Gaussian white force (RMS per
+//! coordinate and step, held over the step, so its density is RMS^2 x step up to the internal
+//! rate) plus optional spindle harmonics acts on both coordinates. The outputs are low-passed
+//! and decimated to the requested rate in one step by a windowed-sinc resampler (cutoff 0.4 of
+//! the output rate, stopband below -74 dB from 0.49 of it), so no content above the output's
+//! Nyquist frequency folds into the record.
 
 use crate::error::{DynamicsError, Result, positive};
 use crate::model::ModalModel;
 use crate::operation::Operation;
-use nalgebra::Matrix3;
+use crate::resample::Resampler;
+use nalgebra::Matrix4;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use std::f64::consts::PI;
@@ -147,32 +156,63 @@ pub trait SimulationObserver {
 struct Silent;
 impl SimulationObserver for Silent {}
 
-/// Per mode: ZOH transition (row-major 2x2), input vector, shape, omega_n, zeta_n.
-type ModeStep = ([f64; 4], [f64; 2], [f64; 2], f64, f64);
+/// Fewest internal steps per period of the highest mode. With the cutting force interpolated
+/// linearly over each step (first-order hold, the slope extrapolated from the previous step) the
+/// local error of the regenerative loop is of second order in the step: 100 steps per period
+/// keep the closed-loop damping of seed 000's P3 pole (zeta 0.0038) within about 1 %, where a
+/// force held constant over 20 steps per period lowered it by a third.
+pub const STEPS_PER_MODE_PERIOD: f64 = 100.0;
+/// Fewest internal steps per tooth period in milling: the tooth angles, the
+/// entry and exit of the cut and the loss of contact at zero chip thickness are resolved on this
+/// grid. With 235 steps per tooth period (the mode rule alone) the lifted identification of
+/// seed 002's slotting cut at 2500 rpm / 1 mm gave the multiplier 0.95 for 0.874; with 2000 it
+/// gives 0.866.
+pub const MIN_STEPS_PER_TOOTH: usize = 2000;
+/// Fewest internal steps per delay in turning (continuous cutting).
+pub const MIN_STEPS_PER_DELAY: usize = 50;
+
+/// Per mode: transition (row-major 2x2), input vector of the held force, input vector of the
+/// force's change over the step, shape, omega_n, zeta_n.
+struct ModeStep {
+    phi: [f64; 4],
+    held: [f64; 2],
+    ramp: [f64; 2],
+    shape: [f64; 2],
+    omega: f64,
+    zeta: f64,
+}
 
 /// Simulate a cut.
 pub fn simulate(model: &ModalModel, settings: &SimulationSettings) -> Result<Simulation> {
     simulate_with_observer(model, settings, &Silent)
 }
 
-/// Exact zero-order-hold transition of one mode over `h`: (Phi 2x2 as [a, b, c, d], Gamma 2).
-fn mode_transition(omega: f64, zeta: f64, h: f64) -> ([f64; 4], [f64; 2]) {
-    let m = Matrix3::new(
-        0.0,
-        1.0,
-        0.0,
-        -omega * omega,
-        -2.0 * zeta * omega,
-        1.0,
-        0.0,
-        0.0,
-        0.0,
-    ) * h;
+/// Exact transition of one mode over `h` with a force that varies linearly over the step,
+/// p(t) = p_k + (p_{k+1} - p_k) t / h: (Phi 2x2 as [a, b, c, d], input of p_k, input of
+/// p_{k+1} - p_k), from the exponential of the 4x4 augmented matrix.
+fn mode_transition(omega: f64, zeta: f64, h: f64) -> ([f64; 4], [f64; 2], [f64; 2]) {
+    let mut m = Matrix4::zeros();
+    m[(0, 1)] = h;
+    m[(1, 0)] = -omega * omega * h;
+    m[(1, 1)] = -2.0 * zeta * omega * h;
+    m[(1, 2)] = h;
+    m[(2, 3)] = 1.0;
     let e = m.exp();
     (
         [e[(0, 0)], e[(0, 1)], e[(1, 0)], e[(1, 1)]],
         [e[(0, 2)], e[(1, 2)]],
+        [e[(0, 3)], e[(1, 3)]],
     )
+}
+
+/// The internal step (s) and the number of steps per delay for a model whose highest natural
+/// frequency is `f_max_hz` at delay `tau_s`: a whole number of steps per delay, at least
+/// `min_steps` ([`MIN_STEPS_PER_TOOTH`] in milling, [`MIN_STEPS_PER_DELAY`] in turning), each at
+/// most 1 / ([`STEPS_PER_MODE_PERIOD`] f_max). Independent of the output rate.
+pub fn internal_step(f_max_hz: f64, tau_s: f64, min_steps: usize) -> (f64, usize) {
+    let h_target = 1.0 / (STEPS_PER_MODE_PERIOD * f_max_hz);
+    let steps = ((tau_s / h_target).ceil() as usize).max(min_steps.max(1));
+    (tau_s / steps as f64, steps)
 }
 
 /// Simulate a cut, reporting progress to `observer`.
@@ -194,23 +234,36 @@ pub fn simulate_with_observer(
         .iter()
         .map(|m| m.frequency_hz())
         .fold(0.0, f64::max);
-    let h_target = (1.0 / (20.0 * f_max)).min(0.5 / settings.sample_rate_hz);
-    let steps_per_delay = (tau / h_target).ceil().max(1.0) as usize;
-    let h = tau / steps_per_delay as f64;
-    let total_steps = (settings.duration_s / h).ceil() as usize + 2;
+    let min_steps = match model.operation() {
+        Operation::Turning(_) => MIN_STEPS_PER_DELAY,
+        Operation::Milling(_) => MIN_STEPS_PER_TOOTH,
+    };
+    let (h, steps_per_delay) = internal_step(f_max, tau, min_steps);
+    let n_out = (settings.duration_s * settings.sample_rate_hz).floor() as usize;
+    let mut resampler = Resampler::<2>::new(h, settings.sample_rate_hz);
+    let last_out_s = (n_out.max(1) - 1) as f64 / settings.sample_rate_hz;
+    let total_steps = ((last_out_s + resampler.half_width_s()) / h).ceil() as usize + 2;
+    if total_steps > 2_000_000_000 {
+        return Err(DynamicsError::value(
+            "duration_s",
+            settings.duration_s,
+            "at most 2e9 internal steps",
+        ));
+    }
 
     let modes: Vec<ModeStep> = model
         .modes()
         .iter()
         .map(|m| {
-            let (phi, gamma) = mode_transition(m.omega_rad_s(), m.damping_ratio(), h);
-            (
+            let (phi, held, ramp) = mode_transition(m.omega_rad_s(), m.damping_ratio(), h);
+            ModeStep {
                 phi,
-                gamma,
-                m.mass_normalized_shape(),
-                m.omega_rad_s(),
-                m.damping_ratio(),
-            )
+                held,
+                ramp,
+                shape: m.mass_normalized_shape(),
+                omega: m.omega_rad_s(),
+                zeta: m.damping_ratio(),
+            }
         })
         .collect();
     let nm = modes.len();
@@ -234,28 +287,27 @@ pub fn simulate_with_observer(
     let mut previous_slot = vec![f64::NAN; edges];
 
     let mut rng = rand::rngs::StdRng::seed_from_u64(settings.seed);
-    let n_out = (settings.duration_s * settings.sample_rate_hz).floor() as usize;
     let mut out = [vec![0.0; n_out], vec![0.0; n_out]];
-    let mut pulse = vec![0.0; n_out];
-    let rev_s = 60.0 / settings.speed_rpm;
-    let mut next_rev = 0.0;
-    let mut next_out = 0usize;
     let (mut engaged, mut lost) = (0usize, 0usize);
-    let mut prev_value = [0.0f64; 2];
+    // deterministic (cutting and harmonic) modal forces of the previous step and its contact set
+    let mut previous_force = vec![0.0; nm];
+    let mut previous_contact: Option<u64> = None;
+    let mut modal_force = vec![0.0; nm];
     let report_every = (total_steps / 100).max(1);
 
     for step in 0..total_steps {
         let t = step as f64 * h;
         let x = [
-            (0..nm).map(|n| modes[n].2[0] * q[n]).sum::<f64>(),
-            (0..nm).map(|n| modes[n].2[1] * q[n]).sum::<f64>(),
+            (0..nm).map(|n| modes[n].shape[0] * q[n]).sum::<f64>(),
+            (0..nm).map(|n| modes[n].shape[1] * q[n]).sum::<f64>(),
         ];
         let v = [
-            (0..nm).map(|n| modes[n].2[0] * qd[n]).sum::<f64>(),
-            (0..nm).map(|n| modes[n].2[1] * qd[n]).sum::<f64>(),
+            (0..nm).map(|n| modes[n].shape[0] * qd[n]).sum::<f64>(),
+            (0..nm).map(|n| modes[n].shape[1] * qd[n]).sum::<f64>(),
         ];
         // cutting forces from every edge
         let mut f = [0.0f64; 2];
+        let mut contact = 0u64;
         let slot = step % steps_per_delay;
         previous_slot.copy_from_slice(&surface[slot * edges..(slot + 1) * edges]);
         for j in 0..edges {
@@ -289,6 +341,7 @@ pub fn simulate_with_observer(
                     engaged += 1;
                 }
                 if chip > 0.0 {
+                    contact |= 1 << (j % 64);
                     f[0] += b * chip * u[0];
                     f[1] += b * chip * u[1];
                     if cv > 0.0 {
@@ -307,11 +360,6 @@ pub fn simulate_with_observer(
             }
             surface[slot * edges + j] = new_surface;
         }
-        // forcing: random (ZOH) plus spindle harmonics
-        for fc in f.iter_mut() {
-            let z: f64 = StandardNormal.sample(&mut rng);
-            *fc += settings.random_force_rms_n * z;
-        }
         if settings.harmonic_force_n > 0.0 {
             let harmonic: f64 = (1..=4)
                 .map(|k| (k as f64 * omega_spindle * t + 0.7 * k as f64).cos() / k as f64)
@@ -319,47 +367,50 @@ pub fn simulate_with_observer(
             f[0] += settings.harmonic_force_n * harmonic;
             f[1] += settings.harmonic_force_n * harmonic * 0.5;
         }
-        // output at this instant, interpolated to the sample times inside [t, t + h)
+        // random force, held over the step (white up to the internal rate)
+        let mut r = [0.0f64; 2];
+        for rc in r.iter_mut() {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            *rc = settings.random_force_rms_n * z;
+        }
+        let total = [f[0] + r[0], f[1] + r[1]];
+        // output at this instant
         let value = match settings.quantity {
             Quantity::Displacement => x,
             Quantity::Velocity => v,
             Quantity::Acceleration => {
                 let mut a = [0.0; 2];
                 for (n, md) in modes.iter().enumerate() {
-                    let p = md.2[0] * f[0] + md.2[1] * f[1];
-                    let qdd = p - 2.0 * md.4 * md.3 * qd[n] - md.3 * md.3 * q[n];
-                    a[0] += md.2[0] * qdd;
-                    a[1] += md.2[1] * qdd;
+                    let p = md.shape[0] * total[0] + md.shape[1] * total[1];
+                    let qdd = p - 2.0 * md.zeta * md.omega * qd[n] - md.omega * md.omega * q[n];
+                    a[0] += md.shape[0] * qdd;
+                    a[1] += md.shape[1] * qdd;
                 }
                 a
             }
         };
-        if step > 0 {
-            let t_prev = t - h;
-            while next_out < n_out {
-                let ts = next_out as f64 / settings.sample_rate_hz;
-                if ts > t {
-                    break;
-                }
-                let w = ((ts - t_prev) / h).clamp(0.0, 1.0);
-                out[0][next_out] = prev_value[0] + w * (value[0] - prev_value[0]);
-                out[1][next_out] = prev_value[1] + w * (value[1] - prev_value[1]);
-                if ts >= next_rev - 0.5 / settings.sample_rate_hz {
-                    pulse[next_out] = 1.0;
-                    next_rev += rev_s;
-                }
-                next_out += 1;
-            }
-        }
-        prev_value = value;
-        // advance every mode exactly with the force held over the step
+        resampler.push(value, &mut out);
+        // advance every mode exactly: the cutting and harmonic force ramps over the step with
+        // the slope of the previous step (held when an edge entered, left or lost the cut), the
+        // random force is held
+        let smooth = previous_contact == Some(contact);
         for (n, md) in modes.iter().enumerate() {
-            let p = md.2[0] * f[0] + md.2[1] * f[1];
-            let (a, g) = (md.0, md.1);
+            let p_det = md.shape[0] * f[0] + md.shape[1] * f[1];
+            let p_rand = md.shape[0] * r[0] + md.shape[1] * r[1];
+            let ramp = if smooth {
+                p_det - previous_force[n]
+            } else {
+                0.0
+            };
+            modal_force[n] = p_det;
+            let (a, g, s) = (md.phi, md.held, md.ramp);
             let (q0, v0) = (q[n], qd[n]);
-            q[n] = a[0] * q0 + a[1] * v0 + g[0] * p;
-            qd[n] = a[2] * q0 + a[3] * v0 + g[1] * p;
+            let p = p_det + p_rand;
+            q[n] = a[0] * q0 + a[1] * v0 + g[0] * p + s[0] * ramp;
+            qd[n] = a[2] * q0 + a[3] * v0 + g[1] * p + s[1] * ramp;
         }
+        previous_force.copy_from_slice(&modal_force);
+        previous_contact = Some(contact);
         if !(q.iter().all(|v| v.is_finite())) {
             return Err(DynamicsError::invalid(
                 "simulation",
@@ -371,6 +422,17 @@ pub fn simulate_with_observer(
         }
     }
     observer.progress(1.0);
+    // once-per-revolution pulses at the output samples nearest each revolution start
+    let rev_s = 60.0 / settings.speed_rpm;
+    let mut pulse = vec![0.0; n_out];
+    let mut next_rev = 0.0;
+    for (k, p) in pulse.iter_mut().enumerate() {
+        let ts = k as f64 / settings.sample_rate_hz;
+        if ts >= next_rev - 0.5 / settings.sample_rate_hz {
+            *p = 1.0;
+            next_rev += rev_s;
+        }
+    }
     let names = model.operation().coordinates();
     let [c0, c1] = out;
     Ok(Simulation {

@@ -22,7 +22,9 @@
 //! - [`lifting`]: lifting of time-periodic signals at their period (002 Eq. 6-7).
 //! - [`stabilization`]: stabilization diagrams over model orders.
 //! - [`picking`]: automatic choice of the dominant structural pole.
-//! - [`spectrum`]: first singular value of the cross-PSD matrix.
+//! - [`spectrum`]: first singular value of the cross-PSD matrix; Welch densities.
+//! - [`detection`]: chatter detection, self-excited lines against the harmonics of a
+//!   fundamental.
 //! - [`synthetic`]: seeded records with known poles (the reference problems of tests and
 //!   benches).
 //! - [`identify`](mod@identify): all of it in one call, with repeated identification on random
@@ -39,6 +41,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod correlation;
+pub mod detection;
 pub mod error;
 pub mod harmonics;
 pub mod identify;

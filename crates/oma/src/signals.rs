@@ -178,6 +178,78 @@ impl Signals {
         let names = names.unwrap_or_else(|| (1..=nc).map(|i| format!("ch{i}")).collect());
         Self::new(names, spec.sample_rate as f64, data).map_err(|e| err(e.to_string()))
     }
+
+    /// Decode an MP3 record (with symphonia) into channels `ch1`, `ch2`, ... at its own
+    /// sample rate. Packets that fail to decode are skipped (as players do).
+    pub fn from_mp3(path: &Path) -> Result<Self> {
+        use symphonia::core::codecs::audio::AudioDecoderOptions;
+        use symphonia::core::formats::probe::Hint;
+        use symphonia::core::formats::{FormatOptions, TrackType};
+        use symphonia::core::io::MediaSourceStream;
+        use symphonia::core::meta::MetadataOptions;
+        let err = |message: String| OmaError::File {
+            path: path.to_path_buf(),
+            message,
+        };
+        let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+        let stream = MediaSourceStream::new(Box::new(file), Default::default());
+        let mut hint = Hint::new();
+        hint.with_extension("mp3");
+        let mut format = symphonia::default::get_probe()
+            .probe(
+                &hint,
+                stream,
+                FormatOptions::default(),
+                MetadataOptions::default(),
+            )
+            .map_err(|e| err(format!("not a decodable MP3: {e}")))?;
+        let track = format
+            .default_track(TrackType::Audio)
+            .ok_or_else(|| err("no audio track".into()))?;
+        let track_id = track.id;
+        let params = track
+            .codec_params
+            .as_ref()
+            .and_then(|p| p.audio())
+            .ok_or_else(|| err("no audio codec parameters".into()))?;
+        let mut decoder = symphonia::default::get_codecs()
+            .make_audio_decoder(params, &AudioDecoderOptions::default())
+            .map_err(|e| err(format!("no decoder: {e}")))?;
+        let mut interleaved: Vec<f32> = Vec::new();
+        let mut buffer: Vec<f32> = Vec::new();
+        let (mut rate, mut channels) = (0u32, 0usize);
+        loop {
+            let packet = match format.next_packet() {
+                Ok(Some(p)) => p,
+                Ok(None) => break,
+                Err(e) => return Err(err(format!("reading packets: {e}"))),
+            };
+            if packet.track_id != track_id {
+                continue;
+            }
+            match decoder.decode(&packet) {
+                Ok(audio) => {
+                    let spec = audio.spec();
+                    rate = spec.rate();
+                    channels = spec.channels().count();
+                    buffer.resize(audio.samples_interleaved(), 0.0);
+                    audio.copy_to_slice_interleaved(&mut buffer);
+                    interleaved.extend_from_slice(&buffer);
+                }
+                Err(symphonia::core::errors::Error::DecodeError(_)) => continue,
+                Err(e) => return Err(err(format!("decoding: {e}"))),
+            }
+        }
+        if channels == 0 || rate == 0 {
+            return Err(err("no audio decoded".into()));
+        }
+        let mut data = vec![Vec::with_capacity(interleaved.len() / channels); channels];
+        for (k, v) in interleaved.into_iter().enumerate() {
+            data[k % channels].push(f64::from(v));
+        }
+        let names = (1..=channels).map(|i| format!("ch{i}")).collect();
+        Self::new(names, f64::from(rate), data).map_err(|e| err(e.to_string()))
+    }
 }
 
 #[cfg(test)]

@@ -99,6 +99,74 @@ pub fn first_singular_value(
     })
 }
 
+/// One-sided Welch power spectral density of one channel (units^2 / Hz): Hann segments of
+/// `segment_len` samples (>= 4, at most the record) with 50 % overlap, averaged.
+pub fn power_spectral_density(
+    x: &[f64],
+    sample_rate_hz: f64,
+    segment_len: usize,
+) -> Result<Spectrum> {
+    if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
+        return Err(OmaError::InvalidInput {
+            field: "sample_rate_hz",
+            message: format!("{sample_rate_hz}; expected a rate > 0"),
+        });
+    }
+    if segment_len < 4 || segment_len > x.len() {
+        return Err(OmaError::InvalidInput {
+            field: "segment_len",
+            message: format!(
+                "{segment_len} samples per segment of {} samples; expected 4 to the record length",
+                x.len()
+            ),
+        });
+    }
+    let window: Vec<f64> = (0..segment_len)
+        .map(|k| 0.5 - 0.5 * (2.0 * PI * k as f64 / segment_len as f64).cos())
+        .collect();
+    let fft = FftPlanner::<f64>::new().plan_fft_forward(segment_len);
+    let bins = segment_len / 2 + 1;
+    let step = segment_len / 2;
+    let segments = (x.len() - segment_len) / step + 1;
+    let mut acc = vec![0.0; bins];
+    let mut buf = vec![Complex64::new(0.0, 0.0); segment_len];
+    let mut scratch = vec![Complex64::new(0.0, 0.0); fft.get_inplace_scratch_len()];
+    for s in 0..segments {
+        let start = s * step;
+        for ((b, v), w) in buf
+            .iter_mut()
+            .zip(&x[start..start + segment_len])
+            .zip(&window)
+        {
+            *b = Complex64::new(v * w, 0.0);
+        }
+        fft.process_with_scratch(&mut buf, &mut scratch);
+        for (a, b) in acc.iter_mut().zip(&buf) {
+            *a += b.norm_sqr();
+        }
+    }
+    let power: f64 = window.iter().map(|w| w * w).sum();
+    let scale = 1.0 / (sample_rate_hz * power * segments as f64);
+    let values = acc
+        .into_iter()
+        .enumerate()
+        .map(|(k, a)| {
+            let one_sided = if k == 0 || 2 * k == segment_len {
+                1.0
+            } else {
+                2.0
+            };
+            one_sided * scale * a
+        })
+        .collect();
+    Ok(Spectrum {
+        frequencies_hz: (0..bins)
+            .map(|k| k as f64 * sample_rate_hz / segment_len as f64)
+            .collect(),
+        values,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,225 @@
+//! `chatter detect`: stable or chatter, and the chatter frequency, for every signal record of an
+//! observations file (`chatter_oma::detection`).
+//!
+//! Each record is read (CSV at the entry's `sample_rate_hz`, WAV or MP3 at its own rate); its
+//! `once_per_rev_channel`, if any, gives the spindle frequency and is left out of the spectrum,
+//! otherwise the spindle frequency is `speed_rpm / 60` refined within 0.5 %. Every multiple of
+//! the spindle frequency (spindle and tooth-passing harmonics alike) is forced response; the
+//! strongest other line is chatter when its share of the power is constant (a limit cycle) or
+//! grows and bursts far beyond a random resonance (see the `chatter_oma::detection` docs). The
+//! output is an observations JSON with the input's `cuts`, then one `cuts` entry per record
+//! (`speed_rpm`, `depth_mm`, `stable`, `chatter_hz` when it chattered, `sequence` and
+//! `radial_immersion` copied) whose `note` carries the evidence in the form
+//! `detect <file>: line F Hz, V v (chatter if <= a or >= b), margin m, line/forced x dB,
+//! line/floor y dB, spindle f Hz, df d Hz`. `--plot DIR` writes `DIR/detect-N.svg`, the
+//! spectrum of record N with the harmonics and the line marked.
+
+use crate::output::emit;
+use anyhow::{Context, Result, bail};
+use chatter_dynamics::{Cut, ModalModel, Observations, Operation, SignalRecord};
+use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
+use chatter_oma::signals::Signals;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `chatter detect`.
+#[derive(Debug, clap::Args)]
+pub struct DetectArgs {
+    /// Observations file listing the `signals` (CSV, WAV or MP3).
+    #[arg(long)]
+    pub observations: PathBuf,
+    /// Machine model: a milling model's tooth count is reported in the plot title (the
+    /// detection itself needs only the spindle frequency).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Folder for one SVG spectrum per record (detect-1.svg, detect-2.svg, ...).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Fundamentals of other forced combs to leave out (Hz), e.g. the mains frequency 50 or 60.
+    #[arg(long, value_delimiter = ',')]
+    pub interference_hz: Vec<f64>,
+    /// Write the JSON here instead of stdout.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// `chatter detect`.
+pub fn run(args: &DetectArgs) -> Result<()> {
+    let observations = crate::inputs::observations(&args.observations)?;
+    let model = args
+        .model
+        .as_deref()
+        .map(crate::inputs::model)
+        .transpose()?;
+    if observations.signals.is_empty() {
+        bail!(
+            "{}: no `signals` to examine; expected at least one entry with a `file`",
+            args.observations.display()
+        );
+    }
+    let mut cuts = observations.cuts.clone();
+    for (i, record) in observations.signals.iter().enumerate() {
+        let context = || {
+            format!(
+                "{}: signals[{i}] ({})",
+                args.observations.display(),
+                record.file.display()
+            )
+        };
+        let signals = read_record(i, record).with_context(context)?;
+        let mut options = DetectionOptions::new(record.speed_rpm / 60.0);
+        options.once_per_rev_channel = record.once_per_rev_channel.clone();
+        options.interference_hz = args.interference_hz.clone();
+        let detection = detect(&signals, &options).with_context(context)?;
+        if let Some(dir) = &args.plot {
+            let path = dir.join(format!("detect-{}.svg", i + 1));
+            draw(&path, record, model.as_ref(), &detection).with_context(context)?;
+            eprintln!("wrote {}", path.display());
+        }
+        cuts.push(cut(record, &detection));
+    }
+    let result = Observations {
+        cuts,
+        poles: observations.poles,
+        signals: Vec::new(),
+    };
+    emit(args.out.as_deref(), &result.to_json_string())
+}
+
+/// The record's channels: CSV at the entry's rate, WAV or MP3 at their own.
+fn read_record(i: usize, record: &SignalRecord) -> Result<Signals> {
+    let extension = record
+        .file
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    Ok(match extension.as_deref() {
+        Some("wav") => Signals::from_wav(&record.file, None)?,
+        Some("mp3") => Signals::from_mp3(&record.file)?,
+        _ => {
+            let fs = record.sample_rate_hz.with_context(|| {
+                format!(
+                    "`signals[{i}].sample_rate_hz` is missing: a CSV record needs its sample rate"
+                )
+            })?;
+            Signals::from_csv(&record.file, fs)?
+        }
+    })
+}
+
+fn cut(record: &SignalRecord, d: &Detection) -> Cut {
+    let e = &d.evidence;
+    let name = record.file.file_name().map_or_else(
+        || record.file.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    Cut {
+        speed_rpm: record.speed_rpm,
+        depth_mm: record.depth_mm,
+        stable: d.verdict == Verdict::Stable,
+        chatter_hz: d.chatter_hz,
+        sequence: record.sequence,
+        radial_immersion: record.radial_immersion,
+        note: Some(format!(
+            "detect {name}: line {:.2} Hz, V {:.3} (chatter if <= {} or >= {}), margin {:+.3}, \
+             line/forced {:+.1} dB, line/floor {:+.1} dB, spindle {:.3} Hz, df {:.3} Hz",
+            e.peak_hz,
+            e.line_variation,
+            e.max_line_variation,
+            e.min_burst_variation,
+            e.margin,
+            e.line_to_forced_db,
+            e.line_to_floor_db,
+            e.fundamental_hz,
+            e.resolution_hz
+        )),
+    }
+}
+
+/// The spectrum (log scale) over the band, the harmonics as grey ticks, the line as a red
+/// marker.
+fn draw(
+    path: &Path,
+    record: &SignalRecord,
+    model: Option<&ModalModel>,
+    d: &Detection,
+) -> Result<()> {
+    let (lo, hi) = d.band_hz;
+    let points: Vec<(f64, f64)> = d
+        .spectrum
+        .frequencies_hz
+        .iter()
+        .zip(&d.spectrum.values)
+        .filter(|(f, v)| **f >= lo && **f <= hi && **v > 0.0)
+        .map(|(f, v)| (*f, v.log10()))
+        .collect();
+    let (ymin, ymax) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.1), b.max(p.1))
+        });
+    if !(ymin.is_finite() && ymax > ymin) {
+        bail!("nothing to plot in {lo:.1}-{hi:.1} Hz");
+    }
+    let teeth = match model.map(ModalModel::operation) {
+        Some(Operation::Milling(m)) => format!(", {} teeth", m.teeth()),
+        _ => String::new(),
+    };
+    let verdict = match d.chatter_hz {
+        Some(f) => format!("chatter at {f:.1} Hz"),
+        None => "stable".into(),
+    };
+    let title = format!(
+        "{} rpm, {} mm{teeth}: {verdict} (V {:.2})",
+        record.speed_rpm, record.depth_mm, d.evidence.line_variation
+    );
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
+        let e = |e: DrawingAreaErrorKind<std::io::Error>| anyhow::anyhow!("{e}");
+        root.fill(&WHITE).map_err(e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(lo..hi, ymin..ymax + 0.5)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("frequency (Hz)")
+            .y_desc("log10 normalized PSD (1/Hz)")
+            .draw()
+            .map_err(e)?;
+        chart
+            .draw_series(d.harmonics_hz.iter().map(|f| {
+                PathElement::new(vec![(*f, ymin), (*f, ymax + 0.5)], RGBColor(200, 200, 200))
+            }))
+            .map_err(e)?
+            .label("spindle harmonics")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(200, 200, 200)));
+        chart
+            .draw_series(LineSeries::new(points, BLUE.stroke_width(1)))
+            .map_err(e)?
+            .label("spectrum")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+        let peak = d.evidence.peak_hz;
+        let color = if d.chatter_hz.is_some() { RED } else { BLACK };
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (peak, ymax + 0.2),
+                6,
+                color.stroke_width(2),
+            )))
+            .map_err(e)?
+            .label(format!("strongest non-synchronous line, {peak:.1} Hz"))
+            .legend(move |(x, y)| Cross::new((x + 10, y), 6, color.stroke_width(2)));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(e)?;
+        root.present().map_err(e)?;
+    }
+    crate::output::write_atomic(path, svg.as_bytes())
+}

@@ -1,0 +1,498 @@
+//! Chatter detection: is there a self-excited vibration in a record, beside the response forced
+//! at the harmonics of a known fundamental (the spindle frequency), and at what frequency.
+//!
+//! Knows nothing of machining beyond the fundamental: every multiple k f_0 (spindle and
+//! tooth-passing harmonics alike, since the tooth-passing frequency is a multiple of the
+//! spindle's) is "synchronous".
+//!
+//! # Spectrum
+//! Each channel (mean removed, divided by its standard deviation so that channels of different
+//! units weigh alike) gives a Welch power spectral density (Hann segments of 2^m samples with a
+//! bin width df at most the requested resolution, 50 % overlap); the densities are summed.
+//!
+//! # Fundamental
+//! Without a once-per-revolution channel the nominal f_0 is refined within
+//! +-[`DetectionOptions::speed_tolerance`] to the value that maximizes sum_k ln S(k f_0) over the
+//! harmonics in the band (a logarithmic comb, so a single strong chatter line cannot pull the
+//! comb onto itself); with one, f_0 is the pulse rate.
+//!
+//! # Criterion
+//! A bin is synchronous when it lies within 2.5 df + k f_0 [`HARMONIC_TOLERANCE`] of a multiple
+//! k f_0 (or of a multiple of one of [`DetectionOptions::interference_hz`]). In the band
+//! [`DetectionOptions::min_frequency_hz`] .. [`DetectionOptions::max_frequency_hz`] the
+//! strongest non-synchronous local maximum of the density is the candidate line. What tells a
+//! self-excited vibration from a structural resonance driven by the random part of the cutting
+//! force is not its level, which depends on the unknown excitation, but its amplitude: a limit
+//! cycle has a constant one, a resonance driven by broadband forces is a narrowband Gaussian
+//! process whose power in a short window is exponentially distributed (coefficient of variation
+//! 1). So the power of the line (three bins around it, segments of half the spectrum's length
+//! hopped by a quarter over the record's second half, where a growing vibration has settled) has
+//! its coefficient of variation V computed, and the record chatters when
+//! - V <= [`DetectionOptions::max_line_variation`] (default [`MAX_LINE_VARIATION`]): a limit
+//!   cycle, or V >= [`DetectionOptions::min_burst_variation`] (default
+//!   [`MIN_BURST_VARIATION`]): a line that grows or comes and goes far beyond the scatter of a
+//!   stationary resonance (intermittent chatter, as in real cuts), and
+//! - the line stands [`MIN_LINE_TO_FLOOR_DB`] above the floor, the median density of the
+//!   non-synchronous bins (so that a record of noise is never chatter).
+//!
+//! The margin reported is the larger of the two threshold distances (positive: chatter). On simulated lobe diagrams
+//! (see `tests/detection.rs`) V was at most 0.19 in chatter and between 0.37 and 0.94 in stable
+//! cuts; on the real chatter record `test255_accelY.csv` (intermittent chatter) it is 2.0.
+//! Also reported: the line's power against the synchronous (forced) power, E_line / E_sync, and
+//! against everything else in the band, both less the floor, in dB.
+//!
+//! A stationary deterministic line that is not a multiple of f_0 (mains hum, a neighbouring
+//! machine) has a constant amplitude too: give its fundamental in
+//! [`DetectionOptions::interference_hz`]. Period-doubling (flip) chatter of a cutter with an even
+//! number of teeth lies on spindle harmonics and is not detected.
+//!
+//! The chatter frequency is the line's, refined by a parabola through the logarithms of the
+//! three densities around it.
+
+use crate::error::{OmaError, Result};
+use crate::signals::Signals;
+use crate::spectrum::{Spectrum, power_spectral_density};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Default largest coefficient of variation of the line's power, over the segments of the
+/// record's second half, for chatter.
+pub const MAX_LINE_VARIATION: f64 = 0.3;
+/// Default smallest coefficient of variation of the line's share for intermittent or growing
+/// chatter: far beyond the scatter of a stationary random resonance (about 1 +- 0.25 over the
+/// segments of a few seconds).
+pub const MIN_BURST_VARIATION: f64 = 1.6;
+/// A chatter line stands at least this far above the broadband floor (dB, peak density over
+/// floor density).
+pub const MIN_LINE_TO_FLOOR_DB: f64 = 20.0;
+/// Relative width of the synchronous band around each harmonic, beyond the window's 2.5 bins:
+/// the spindle speed drifts by this fraction during a record.
+pub const HARMONIC_TOLERANCE: f64 = 5e-4;
+/// Default relative search range of the fundamental around its nominal value.
+pub const SPEED_TOLERANCE: f64 = 0.005;
+
+/// Options of [`detect`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DetectionOptions {
+    /// Nominal fundamental (Hz): the spindle rotation frequency, rpm / 60.
+    pub fundamental_hz: f64,
+    /// Finest bin width wanted (Hz); default `None`: f_0 / 10, at most 2 Hz, with at least 8
+    /// segments in the record.
+    pub resolution_hz: Option<f64>,
+    /// Lowest frequency searched (Hz); default `None`: f_0 / 2.
+    pub min_frequency_hz: Option<f64>,
+    /// Highest frequency searched (Hz); default `None`: 0.45 times the sample rate.
+    pub max_frequency_hz: Option<f64>,
+    /// Relative search range of the fundamental (default [`SPEED_TOLERANCE`]; 0 keeps the
+    /// nominal value).
+    pub speed_tolerance: f64,
+    /// Largest coefficient of variation of the line's power for chatter, default
+    /// [`MAX_LINE_VARIATION`].
+    pub max_line_variation: f64,
+    /// Smallest coefficient of variation of the line's share for intermittent or growing
+    /// chatter, default [`MIN_BURST_VARIATION`].
+    pub min_burst_variation: f64,
+    /// Name of a once-per-revolution channel: excluded from the spectrum, its pulse rate is f_0.
+    pub once_per_rev_channel: Option<String>,
+    /// Fundamentals of other known forced combs (Hz), e.g. the mains frequency whose harmonics
+    /// an accelerometer cable picks up; their multiples are synchronous too (default none).
+    pub interference_hz: Vec<f64>,
+}
+
+impl DetectionOptions {
+    /// Options with the documented defaults for fundamental `fundamental_hz`.
+    pub fn new(fundamental_hz: f64) -> Self {
+        Self {
+            fundamental_hz,
+            resolution_hz: None,
+            min_frequency_hz: None,
+            max_frequency_hz: None,
+            speed_tolerance: SPEED_TOLERANCE,
+            max_line_variation: MAX_LINE_VARIATION,
+            min_burst_variation: MIN_BURST_VARIATION,
+            once_per_rev_channel: None,
+            interference_hz: Vec::new(),
+        }
+    }
+}
+
+/// The verdict on one record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// No self-excited line dominates the forced response.
+    Stable,
+    /// A self-excited line dominates.
+    Chatter,
+}
+
+/// The numbers behind a verdict (see the [module documentation](self#criterion)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DetectionEvidence {
+    /// Fundamental used (Hz), after refinement.
+    pub fundamental_hz: f64,
+    /// Frequency of the strongest non-synchronous peak (Hz).
+    pub peak_hz: f64,
+    /// R = 10 log10(E_line / E_sync) (dB).
+    pub line_to_forced_db: f64,
+    /// Peak density over the floor density (dB).
+    pub line_to_floor_db: f64,
+    /// 10 log10 of E_line over the power of everything else in the band, synchronous or not
+    /// (dB).
+    pub line_to_rest_db: f64,
+    /// The limit-cycle threshold of the line variation.
+    pub max_line_variation: f64,
+    /// The burst threshold of the line variation.
+    pub min_burst_variation: f64,
+    /// The larger of (limit-cycle threshold - V) and (V - burst threshold): positive for
+    /// chatter (unless the line does not stand [`MIN_LINE_TO_FLOOR_DB`] above the floor).
+    pub margin: f64,
+    /// Bin width (Hz).
+    pub resolution_hz: f64,
+    /// Coefficient of variation of the line's power over the segments of the record's second
+    /// half: about 1 for a stable resonance driven by random forces (a narrowband Gaussian
+    /// process), near 0 for a limit cycle.
+    pub line_variation: f64,
+}
+
+/// Result of [`detect`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Detection {
+    /// Stable or chatter.
+    pub verdict: Verdict,
+    /// The chatter frequency (Hz) when the verdict is chatter.
+    pub chatter_hz: Option<f64>,
+    /// The numbers behind the verdict.
+    pub evidence: DetectionEvidence,
+    /// Summed normalized density (1 / Hz) from 0 to the Nyquist frequency.
+    pub spectrum: Spectrum,
+    /// The harmonics k f_0 in the band (Hz).
+    pub harmonics_hz: Vec<f64>,
+    /// The band searched (Hz).
+    pub band_hz: (f64, f64),
+}
+
+fn invalid(field: &'static str, message: String) -> OmaError {
+    OmaError::InvalidInput { field, message }
+}
+
+/// Decide whether `signals` chatter (see the [module documentation](self)).
+pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection> {
+    let fs = signals.sample_rate_hz;
+    let nyquist = fs / 2.0;
+    let f0_nominal = options.fundamental_hz;
+    if !(f0_nominal.is_finite() && f0_nominal > 0.0 && f0_nominal < nyquist) {
+        return Err(invalid(
+            "fundamental_hz",
+            format!("{f0_nominal} Hz; expected a frequency in (0, {nyquist}) Hz"),
+        ));
+    }
+    if !(options.speed_tolerance.is_finite() && (0.0..0.2).contains(&options.speed_tolerance)) {
+        return Err(invalid(
+            "speed_tolerance",
+            format!(
+                "{}; expected a fraction in [0, 0.2)",
+                options.speed_tolerance
+            ),
+        ));
+    }
+    if !(options.max_line_variation.is_finite()
+        && options.max_line_variation > 0.0
+        && options.min_burst_variation > options.max_line_variation)
+    {
+        return Err(invalid(
+            "max_line_variation",
+            format!(
+                "{} (burst threshold {}); expected 0 < max_line_variation < min_burst_variation",
+                options.max_line_variation, options.min_burst_variation
+            ),
+        ));
+    }
+    // channels and fundamental
+    let (signals, f0_pulse) = match &options.once_per_rev_channel {
+        Some(name) => {
+            let c = signals.channel(name).ok_or_else(|| {
+                invalid(
+                    "once_per_rev_channel",
+                    format!("`{name}` is not among the channels {:?}", signals.names),
+                )
+            })?;
+            let period = signals.pulse_period_s(c)?;
+            (signals.without_channel(c)?, Some(1.0 / period))
+        }
+        None => (signals.clone(), None),
+    };
+    let n = signals.data[0].len();
+    let resolution = match options.resolution_hz {
+        Some(r) if !(r.is_finite() && r > 0.0) => {
+            return Err(invalid(
+                "resolution_hz",
+                format!("{r} Hz; expected a bin width > 0"),
+            ));
+        }
+        Some(r) => r,
+        None => (f0_nominal / 10.0).min(2.0),
+    };
+    // segment: a power of two with df <= resolution, at most an eighth of the record (at
+    // least 64 samples)
+    let mut segment = 64usize;
+    while (fs / segment as f64) > resolution && segment * 2 <= (n / 4).max(64) {
+        segment *= 2;
+    }
+    if segment > n {
+        return Err(invalid(
+            "samples",
+            format!("{n} samples; need at least {segment} for the spectrum"),
+        ));
+    }
+    let df = fs / segment as f64;
+    let mut psd = vec![0.0; segment / 2 + 1];
+    // channels in parallel, summed in channel order (independent of the thread count)
+    let densities: Vec<Option<Spectrum>> = signals
+        .data
+        .par_iter()
+        .map(|ch| {
+            let mean = ch.iter().sum::<f64>() / n as f64;
+            let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+            if var <= 0.0 {
+                return Ok(None); // a constant channel carries nothing
+            }
+            let scale = 1.0 / var.sqrt();
+            let normalized: Vec<f64> = ch.iter().map(|v| (v - mean) * scale).collect();
+            power_spectral_density(&normalized, fs, segment).map(Some)
+        })
+        .collect::<Result<_>>()?;
+    for s in densities.into_iter().flatten() {
+        for (a, b) in psd.iter_mut().zip(&s.values) {
+            *a += b;
+        }
+    }
+    let lo = options.min_frequency_hz.unwrap_or(f0_nominal / 2.0);
+    let hi = options.max_frequency_hz.unwrap_or(0.45 * fs).min(nyquist);
+    if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo + 8.0 * df) {
+        return Err(invalid(
+            "band",
+            format!("{lo} to {hi} Hz; expected 0 <= min < max <= Nyquist, at least 8 bins wide"),
+        ));
+    }
+    let first = ((lo / df).ceil() as usize).max(1);
+    let last = ((hi / df).floor() as usize).min(psd.len() - 1);
+
+    let f0 = f0_pulse.unwrap_or_else(|| refine_fundamental(&psd, df, f0_nominal, hi, options));
+    if let Some(f) = options
+        .interference_hz
+        .iter()
+        .find(|f| !(f.is_finite() && **f > 0.0))
+    {
+        return Err(invalid(
+            "interference_hz",
+            format!("{f} Hz; expected fundamentals > 0 Hz"),
+        ));
+    }
+    let near_multiple = |f: f64, base: f64| {
+        let k = (f / base).round().max(1.0);
+        (f - k * base).abs() <= 2.5 * df + k * base * HARMONIC_TOLERANCE
+    };
+    let synchronous = |i: usize| {
+        let f = i as f64 * df;
+        near_multiple(f, f0) || options.interference_hz.iter().any(|b| near_multiple(f, *b))
+    };
+    let mut floor_values: Vec<f64> = (first..=last)
+        .filter(|i| !synchronous(*i))
+        .map(|i| psd[i])
+        .collect();
+    if floor_values.is_empty() {
+        return Err(invalid(
+            "resolution_hz",
+            format!("{df} Hz bins leave no bin between the harmonics of {f0} Hz"),
+        ));
+    }
+    let mid = floor_values.len() / 2;
+    let floor = *floor_values
+        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
+        .1;
+    // strongest non-synchronous local maximum
+    let peak = (first..=last)
+        .filter(|&i| !synchronous(i))
+        .filter(|&i| psd[i] >= psd[i - 1] && psd.get(i + 1).is_none_or(|v| psd[i] >= *v))
+        .max_by(|a, b| psd[*a].total_cmp(&psd[*b]));
+    let Some(peak) = peak else {
+        return Err(OmaError::NoPole(
+            "no non-synchronous peak in the band".into(),
+        ));
+    };
+    let e_line: f64 = (peak.saturating_sub(2)..=(peak + 2).min(psd.len() - 1))
+        .filter(|&i| !synchronous(i))
+        .map(|i| (psd[i] - floor).max(0.0))
+        .sum::<f64>()
+        * df;
+    let e_sync: f64 = (first..=last)
+        .filter(|&i| synchronous(i))
+        .map(|i| (psd[i] - floor).max(0.0))
+        .sum::<f64>()
+        * df;
+    let e_rest: f64 = (first..=last)
+        .filter(|&i| !synchronous(i) && i.abs_diff(peak) > 2)
+        .map(|i| (psd[i] - floor).max(0.0))
+        .sum::<f64>()
+        * df;
+    let tiny = f64::MIN_POSITIVE;
+    let line_to_rest_db = 10.0 * ((e_line + tiny) / (e_sync + e_rest + floor * df)).log10();
+    let line_to_forced_db = 10.0 * ((e_line + tiny) / (e_sync + floor * df)).log10();
+    let line_to_floor_db = 10.0 * (psd[peak] / floor.max(tiny)).log10();
+    let peak_hz = refine_peak(&psd, peak, df);
+    let line_variation = line_variation(&signals.data, segment, peak);
+    let margin = (options.max_line_variation - line_variation)
+        .max(line_variation - options.min_burst_variation);
+    let chatter = margin >= 0.0 && line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
+    let harmonics_hz = (1..)
+        .map(|k| k as f64 * f0)
+        .skip_while(|f| *f < lo)
+        .take_while(|f| *f <= hi)
+        .collect();
+    Ok(Detection {
+        verdict: if chatter {
+            Verdict::Chatter
+        } else {
+            Verdict::Stable
+        },
+        chatter_hz: chatter.then_some(peak_hz),
+        evidence: DetectionEvidence {
+            fundamental_hz: f0,
+            peak_hz,
+            line_to_forced_db,
+            line_to_floor_db,
+            line_to_rest_db,
+            max_line_variation: options.max_line_variation,
+            min_burst_variation: options.min_burst_variation,
+            margin,
+            resolution_hz: df,
+            line_variation,
+        },
+        spectrum: Spectrum {
+            frequencies_hz: (0..psd.len()).map(|i| i as f64 * df).collect(),
+            values: psd,
+        },
+        harmonics_hz,
+        band_hz: (lo, hi),
+    })
+}
+
+/// The fundamental within the search range that maximizes the logarithmic harmonic comb.
+fn refine_fundamental(psd: &[f64], df: f64, f0: f64, hi: f64, options: &DetectionOptions) -> f64 {
+    let delta = options.speed_tolerance;
+    if delta == 0.0 {
+        return f0;
+    }
+    let k_max = ((hi / f0).floor() as usize).clamp(1, 200);
+    // steps that move the highest harmonic by a quarter bin
+    let step = 0.25 * df / k_max as f64;
+    let count = ((2.0 * delta * f0 / step).ceil() as usize).clamp(1, 20_000);
+    // ln of the largest density within a bin of each frequency, tabulated once
+    let near_ln: Vec<f64> = (0..psd.len())
+        .map(|i| {
+            (i.saturating_sub(1)..=(i + 1).min(psd.len() - 1))
+                .map(|j| psd[j])
+                .fold(f64::MIN_POSITIVE, f64::max)
+                .ln()
+        })
+        .collect();
+    let value_near = |f: f64| near_ln[((f / df).round() as usize).min(psd.len() - 1)];
+    (0..=count)
+        .map(|c| f0 * (1.0 - delta) + c as f64 * 2.0 * delta * f0 / count as f64)
+        .map(|f| {
+            let score: f64 = (1..=k_max).map(|k| value_near(k as f64 * f)).sum();
+            (f, score)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(f0, |(f, _)| f)
+}
+
+/// Peak frequency from a parabola through the logarithms of the densities at bins i-1, i, i+1.
+fn refine_peak(psd: &[f64], i: usize, df: f64) -> f64 {
+    if i == 0 || i + 1 >= psd.len() {
+        return i as f64 * df;
+    }
+    let (a, b, c) = (psd[i - 1].ln(), psd[i].ln(), psd[i + 1].ln());
+    let denom = a - 2.0 * b + c;
+    let shift = if denom.abs() > 0.0 && denom.is_finite() {
+        (0.5 * (a - c) / denom).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    (i as f64 + shift) * df
+}
+
+/// Coefficient of variation of the line's share of the power over the record's second half
+/// (the line's power over the segment's power, so that a cut that deepens or leaves the
+/// workpiece changes neither): segments of
+/// half the spectrum's length (so the line, at bin `peak` of the spectrum, falls at bin
+/// peak / 2 of theirs), Hann windowed, hopped by a quarter of their length; the power is summed
+/// over the three bins around the line and over the standardized channels.
+fn line_variation(data: &[Vec<f64>], spectrum_segment: usize, peak: usize) -> f64 {
+    let n = data[0].len();
+    let segment = (spectrum_segment / 2).max(16);
+    let step = (segment / 4).max(1);
+    let centre = (peak as f64 / 2.0).round() as usize;
+    if n < segment {
+        return f64::NAN;
+    }
+    let starts: Vec<usize> = (0..=(n - segment) / step)
+        .map(|s| s * step)
+        .filter(|s| *s >= n / 2)
+        .collect();
+    let window: Vec<f64> = (0..segment)
+        .map(|k| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / segment as f64).cos())
+        .collect();
+    let twiddles: Vec<(f64, f64)> = (centre.saturating_sub(1)..=centre + 1)
+        .map(|b| {
+            let w = 2.0 * std::f64::consts::PI * b as f64 / segment as f64;
+            (w.cos(), w.sin())
+        })
+        .collect();
+    let stats: Vec<(f64, f64)> = data
+        .iter()
+        .map(|ch| {
+            let mean = ch.iter().sum::<f64>() / n as f64;
+            let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+            (mean, if var > 0.0 { 1.0 / var.sqrt() } else { 0.0 })
+        })
+        .collect();
+    let powers: Vec<f64> = starts
+        .par_iter()
+        .map(|&s| {
+            let mut total = 0.0;
+            let mut energy = 0.0;
+            for (ch, (mean, scale)) in data.iter().zip(&stats) {
+                energy += ch[s..s + segment]
+                    .iter()
+                    .zip(&window)
+                    .map(|(v, w)| ((v - mean) * scale * w).powi(2))
+                    .sum::<f64>()
+                    * segment as f64;
+                for &(c, si) in &twiddles {
+                    // DFT at one bin by a rotating phasor
+                    let (mut re, mut im) = (0.0, 0.0);
+                    let (mut cr, mut ci) = (1.0, 0.0);
+                    for (v, w) in ch[s..s + segment].iter().zip(&window) {
+                        let x = (v - mean) * scale * w;
+                        re += x * cr;
+                        im -= x * ci;
+                        let nr = cr * c - ci * si;
+                        ci = cr * si + ci * c;
+                        cr = nr;
+                    }
+                    total += re * re + im * im;
+                }
+            }
+            if energy > 0.0 { total / energy } else { 0.0 }
+        })
+        .collect();
+    if powers.len() < 2 {
+        return f64::NAN;
+    }
+    let m = powers.len() as f64;
+    let mean = powers.iter().sum::<f64>() / m;
+    let var = powers.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (m - 1.0);
+    var.sqrt() / mean
+}
