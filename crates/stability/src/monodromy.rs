@@ -1052,6 +1052,35 @@ mod tests {
         }
     }
 
+    /// The fallback chain of [`robust_eigenpair`] on an operator (a diagonal one of dimension 60
+    /// with dominant eigenvalue 0.9) that overflows on its first `bad` applications: one bad
+    /// application fails the first Arnoldi run and the second one converges; an operator that
+    /// always overflows fails both and the dense matrix answers. Either way the dominant
+    /// eigenvalue is 0.9 to 1e-10.
+    #[test]
+    fn failed_arnoldi_falls_back() {
+        let d = 60;
+        let diagonal = |i: usize| 0.9 * (1.0 - i as f64 / d as f64);
+        for bad in [1, usize::MAX] {
+            let calls = std::cell::Cell::new(0usize);
+            let apply = |x: &[f64], out: &mut [f64]| {
+                calls.set(calls.get() + 1);
+                for (i, (o, xi)) in out.iter_mut().zip(x).enumerate() {
+                    *o = if calls.get() <= bad {
+                        f64::NAN
+                    } else {
+                        diagonal(i) * xi
+                    };
+                }
+            };
+            assert!(arnoldi(apply, d, &ArnoldiConfig::DEFAULT).is_err());
+            calls.set(0);
+            let dense = || DMatrix::from_fn(d, d, |i, j| if i == j { diagonal(i) } else { 0.0 });
+            let (mu, _) = robust_eigenpair(apply, d, dense).unwrap();
+            assert!((mu - 0.9).norm() < 1e-10, "{bad}: {mu}");
+        }
+    }
+
     #[test]
     fn zero_depth_multiplier_is_free_decay() {
         // b = 0: |mu| = exp(-zeta omega_n tau) exactly (free vibration over one delay)
