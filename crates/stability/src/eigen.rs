@@ -27,19 +27,19 @@ pub(crate) enum EigenSolver {
     Schur,
 }
 
-/// The eigenvalues of the upper Hessenberg matrix `rows` (row-major n x n, entries below the
-/// first subdiagonal ignored), with the algorithm that produced them.
+/// The eigenvalues of the n x n upper Hessenberg matrix with entries `entry(i, j)` (entries below
+/// the first subdiagonal ignored), with the algorithm that produced them. The entries are read
+/// once into the Francis iteration's work array, and again only for a fallback.
 pub(crate) fn hessenberg_eigenvalues_robust(
-    rows: &[f64],
     n: usize,
+    entry: impl Fn(usize, usize) -> f64,
 ) -> Result<(Vec<Complex64>, EigenSolver)> {
-    debug_assert_eq!(rows.len(), n * n);
-    check_finite(rows, n)?;
-    let mut work = rows.to_vec();
+    let mut work: Vec<f64> = (0..n * n).map(|k| entry(k / n, k % n)).collect();
+    check_finite(&work, n)?;
     if let Some(values) = hessenberg_eigenvalues(&mut work, n) {
         return Ok((values, EigenSolver::Francis));
     }
-    let dense = DMatrix::from_fn(n, n, |i, j| if i > j + 1 { 0.0 } else { rows[i * n + j] });
+    let dense = DMatrix::from_fn(n, n, |i, j| if i > j + 1 { 0.0 } else { entry(i, j) });
     dense_fallback(&dense)
 }
 
@@ -112,7 +112,7 @@ mod tests {
     #[test]
     fn issue_14_arnoldi_matrix() {
         let rows = ISSUE_14_ARNOLDI;
-        let (ours, solver) = hessenberg_eigenvalues_robust(&rows, 8).unwrap();
+        let (ours, solver) = hessenberg_eigenvalues_robust(8, |i, j| rows[i * 8 + j]).unwrap();
         assert_eq!(solver, EigenSolver::Francis);
         let m = DMatrix::from_row_slice(8, 8, &rows);
         let (reference, _) = dense_fallback(&m).unwrap();
@@ -160,7 +160,7 @@ mod tests {
         let mut m = DMatrix::<f64>::identity(3, 3);
         m[(1, 2)] = f64::NAN;
         assert!(dense_eigenvalues(&m).is_err());
-        assert!(hessenberg_eigenvalues_robust(&[f64::INFINITY], 1).is_err());
+        assert!(hessenberg_eigenvalues_robust(1, |_, _| f64::INFINITY).is_err());
     }
 
     /// Row-major, from the failing run of `chatter lobes --method fdm --speeds 23500:23501:2`.

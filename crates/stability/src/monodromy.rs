@@ -878,8 +878,7 @@ const ARNOLDI_BREAKDOWN: f64 = 1e-12;
 /// The dominant Ritz pair of the leading kk x kk block of `h`: value, the small eigenvector and
 /// the residual estimate |h_{kk+1,kk} x_kk|.
 fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex64>, f64)> {
-    let rows: Vec<f64> = (0..kk * kk).map(|k| h[(k / kk, k % kk)]).collect();
-    let (values, _) = hessenberg_eigenvalues_robust(&rows, kk)?;
+    let (values, _) = hessenberg_eigenvalues_robust(kk, |i, j| h[(i, j)])?;
     let theta = largest(&values)?;
     // Ritz vector of theta by inverse iteration on the small Hessenberg matrix
     let hc = h.view((0, 0), (kk, kk)).map(|x| Complex64::new(x, 0.0));
