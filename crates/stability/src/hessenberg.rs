@@ -9,8 +9,9 @@
 //! matrix whose Krylov space is numerically invariant ends in a block of round-off noise, on
 //! which the local test alone asks for relative accuracy that noise cannot have (issue 14: an
 //! 8 x 8 matrix of the zero-depth monodromy at 23 500 rpm cycled through the whole budget). The
-//! exceptional shifts alternate between the bottom of the active block (EISPACK) and its top
-//! (LAPACK), with a varied magnitude, so that no fixed cycle survives them. When the budget is
+//! exceptional shifts are the classic bottom ones (EISPACK) for the first half of the budget, then
+//! alternate between the bottom of the active block and its top (LAPACK), with a varied
+//! magnitude, so that no fixed cycle survives them. When the budget is
 //! spent anyway the caller falls back to a dense solver ([`crate::eigen`]).
 //!
 //! The Arnoldi iterations of [`crate::monodromy`] test convergence on the eigenvalues of their
@@ -93,9 +94,10 @@ pub(crate) fn hessenberg_eigenvalues(a: &mut [f64], n: usize) -> Option<Vec<Comp
                 // exceptional shift against cycling (badly scaled, far from normal matrices):
                 // from the bottom of the block (EISPACK) and from its top (LAPACK) in turn, the
                 // magnitude varied from one round to the next
-                let round = iterations / EXCEPTIONAL_EVERY;
-                let factor = EXCEPTIONAL_FACTORS[((round - 1) / 2) % EXCEPTIONAL_FACTORS.len()];
-                if round % 2 == 1 {
+                // (the first half of the budget uses the classic bottom shift only)
+                let round = iterations.saturating_sub(15 * n.max(10)) / EXCEPTIONAL_EVERY;
+                let factor = EXCEPTIONAL_FACTORS[(round / 2) % EXCEPTIONAL_FACTORS.len()];
+                if round.is_multiple_of(2) {
                     shift += x;
                     for i in 0..=nn {
                         a[at(i, i)] -= x;
