@@ -2,14 +2,15 @@
 //! always gets its eigenvalues.
 //!
 //! The first choice is the allocation-free Francis iteration of [`crate::hessenberg`] (with its
-//! exceptional shifts). When it spends its iteration budget, the same matrix goes to faer's dense
+//! exceptional shifts), rerun with normwise deflation when it stalls. When that spends its
+//! iteration budget too, the same matrix goes to faer's dense
 //! real eigensolver (Hessenberg reduction and a multishift QR with aggressive early deflation, a
 //! different algorithm with different failure modes), and when that fails too, to nalgebra's
 //! Schur decomposition with a bounded iteration count. Only a matrix with non-finite entries
 //! (an operator that overflowed) or one on which all three fail is an error.
 
 use crate::error::{Result, StabilityError};
-use crate::hessenberg::hessenberg_eigenvalues;
+use crate::hessenberg::{Deflation, francis, hessenberg_eigenvalues};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -39,6 +40,10 @@ pub(crate) fn hessenberg_eigenvalues_robust(
     if let Some(values) = hessenberg_eigenvalues(&mut work, n) {
         return Ok((values, EigenSolver::Francis));
     }
+    let mut work: Vec<f64> = (0..n * n).map(|k| entry(k / n, k % n)).collect();
+    if let Some(values) = francis(&mut work, n, Deflation::Normwise) {
+        return Ok((values, EigenSolver::Francis));
+    }
     let dense = DMatrix::from_fn(n, n, |i, j| if i > j + 1 { 0.0 } else { entry(i, j) });
     dense_fallback(&dense)
 }
@@ -55,6 +60,10 @@ pub(crate) fn dense_eigenvalues(m: &DMatrix<f64>) -> Result<Vec<Complex64>> {
     let h = m.clone().hessenberg().h();
     let mut rows: Vec<f64> = (0..n * n).map(|k| h[(k / n, k % n)]).collect();
     if let Some(values) = hessenberg_eigenvalues(&mut rows, n) {
+        return Ok(values);
+    }
+    let mut rows: Vec<f64> = (0..n * n).map(|k| h[(k / n, k % n)]).collect();
+    if let Some(values) = francis(&mut rows, n, Deflation::Normwise) {
         return Ok(values);
     }
     Ok(dense_fallback(m)?.0)

@@ -4,8 +4,8 @@
 //! LAPACK `dlahqr`: a shift every 10 iterations without deflation, which the far-from-normal
 //! Arnoldi matrices of monodromy operators need).
 //!
-//! Besides the local `hqr` test, a subdiagonal element below the unit round-off times the matrix
-//! norm counts as zero (the normwise criterion of Golub and Van Loan, Section 7.5.1): an Arnoldi
+//! When the iteration stalls, it is rerun with a second rule: besides the local `hqr` test, a
+//! subdiagonal element below the unit round-off times the matrix norm counts as zero (the normwise criterion of Golub and Van Loan, Section 7.5.1): an Arnoldi
 //! matrix whose Krylov space is numerically invariant ends in a block of round-off noise, on
 //! which the local test alone asks for relative accuracy that noise cannot have (issue 14: an
 //! 8 x 8 matrix of the zero-depth monodromy at 23 500 rpm cycled through the whole budget). The
@@ -30,13 +30,30 @@ const EXCEPTIONAL_FACTORS: [f64; 4] = [0.75, 1.6, 0.3, -1.1];
 /// The eigenvalues of the upper Hessenberg matrix `a` (row-major n x n, entries below the first
 /// subdiagonal ignored), destroyed in the process. `None` when the iteration does not converge.
 pub(crate) fn hessenberg_eigenvalues(a: &mut [f64], n: usize) -> Option<Vec<Complex64>> {
+    francis(a, n, Deflation::Local)
+}
+
+/// Which subdiagonal elements count as zero.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Deflation {
+    /// The local `hqr` test only (fastest on the Arnoldi matrices of the solvers).
+    Local,
+    /// Also those below the unit round-off times the matrix norm (the retry after a stall).
+    Normwise,
+}
+
+/// The Francis iteration with the deflation rule `deflation`.
+pub(crate) fn francis(a: &mut [f64], n: usize, deflation: Deflation) -> Option<Vec<Complex64>> {
     debug_assert_eq!(a.len(), n * n);
     let at = |i: usize, j: usize| i * n + j;
     let norm: f64 = (0..n)
         .flat_map(|i| (i.saturating_sub(1)..n).map(move |j| (i, j)))
         .map(|(i, j)| a[at(i, j)].abs())
         .sum();
-    let negligible = f64::EPSILON * norm;
+    let negligible = match deflation {
+        Deflation::Local => 0.0,
+        Deflation::Normwise => f64::EPSILON * norm,
+    };
     let mut values = vec![Complex64::new(0.0, 0.0); n];
     // accumulated exceptional shifts
     let mut shift = 0.0;
