@@ -9,7 +9,7 @@ use anyhow::{Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
-use chatter_uncertainty::montecarlo::sample_boundaries;
+use chatter_uncertainty::montecarlo::{FailureKind, sample_boundaries};
 use chatter_uncertainty::parameters::ParameterDistribution;
 use chatter_uncertainty::perturbation::model_moment_grid;
 use plotters::style::{BLUE, GREEN, RGBColor};
@@ -286,6 +286,23 @@ fn montecarlo(
         &|done, _| bar.set(done),
     )?;
     bar.finish();
+    if !sampled.failures.is_empty() {
+        // failed samples are left out of P_s and the quantiles, never counted as stable
+        let invalid = sampled
+            .failures
+            .iter()
+            .filter(|f| f.kind == FailureKind::InvalidSample)
+            .count();
+        let worst = sampled.failures_per_speed().into_iter().max().unwrap_or(0);
+        eprintln!(
+            "warning: {} sample-speed failures ({} numerical, {invalid} invalid samples), at most \
+             {worst} of {} samples at one speed, left out of the map; first: {}",
+            sampled.failures.len(),
+            sampled.failures.len() - invalid,
+            thetas.len(),
+            sampled.failures[0].message
+        );
+    }
     let depth = sampled.depth_bands();
     let hz = sampled.chatter_frequency_bands();
     let mut csv = String::from(

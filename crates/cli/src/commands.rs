@@ -8,7 +8,7 @@ use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint, lobe_diagram};
 use chatter_stability::monodromy::Discretization;
-use chatter_stability::zero_order::zoa_lobes;
+use chatter_stability::zero_order::{ZeroOrderOptions, limiting_depths, zoa_lobes};
 use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
 use plotters::style::BLUE;
 use std::fmt::Write as _;
@@ -154,7 +154,12 @@ pub fn compute_lobes(
     quiet: bool,
 ) -> Result<Vec<LobePoint>> {
     match method.solver() {
-        None => Ok(zoa_lobes(model, speeds)?),
+        // the model's process damping included (003), as the discretizations do
+        None => Ok(limiting_depths(
+            model,
+            speeds,
+            &ZeroOrderOptions::unbounded(),
+        )?),
         Some(solver) => {
             let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
             let lobes = lobe_diagram(&solver, model, speeds, &BoundaryOptions::default(), &bar)?;

@@ -907,4 +907,47 @@ fn detect_labels_simulated_cuts() {
     .unwrap();
     let err = fail(chatter().args(["detect", "--observations", obs.to_str().unwrap()]));
     assert!(err.contains("sample_rate_hz"), "{err}");
+
+/// `lobes --method zoa` honours the model's process damping (issue 14): on the 003-like flexure
+/// (228 Hz in x, 1 tooth, 50 % up milling, C = 2.5e5 N/m) the zero-order limit at 300 rpm is
+/// 1.698 mm with it (`chatter_stability::zero_order::limiting_depths`) against 0.780 mm without;
+/// at 3000 rpm, where V is ten times higher, process damping adds less (0.863 against 0.821 mm).
+#[test]
+fn zoa_lobes_include_process_damping() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = |c: Option<f64>| {
+        let pd = c.map_or(String::new(), |c| {
+            format!(r#", "process_damping": {{"c_n_per_m": {c}}}"#)
+        });
+        format!(
+            r#"{{"operation": {{"kind": "milling", "teeth": 1, "radial_immersion": 0.5, "direction": "up", "tool_diameter_mm": 18.54}}, "cutting": {{"kt_n_per_mm2": 2111.2, "kn_n_per_mm2": 1052.6}}, "modes": [{{"frequency_hz": 228.0, "damping_ratio": 0.02, "stiffness_n_per_m": 5.6e6, "direction": "x"}}]{pd}}}"#
+        )
+    };
+    let mut depths = Vec::new();
+    for (name, c) in [("damped.json", Some(2.5e5)), ("bare.json", None)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, model(c)).unwrap();
+        let csv = succeed(
+            chatter()
+                .args([
+                    "lobes",
+                    "--quiet",
+                    "--method",
+                    "zoa",
+                    "--speeds",
+                    "300:3000:2",
+                ])
+                .arg("--model")
+                .arg(&path),
+        );
+        let row: Vec<f64> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+            .collect();
+        depths.push(row);
+    }
+    for (got, expected) in depths.iter().flatten().zip([1.698, 0.863, 0.780, 0.821]) {
+        assert!((got - expected).abs() < 2e-3, "{got} vs {expected}");
+    }
 }

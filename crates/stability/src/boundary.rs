@@ -42,7 +42,8 @@ impl Default for BoundaryOptions {
 }
 
 impl BoundaryOptions {
-    fn validate(&self) -> Result<()> {
+    /// Check the options: 0 < start < max depth, growth > 1, tolerance in (0, 0.1).
+    pub fn validate(&self) -> Result<()> {
         if !(self.start_depth_m > 0.0 && self.start_depth_m < self.max_depth_m) {
             return invalid("start_depth_m", self.start_depth_m, "0 < start < max depth");
         }
@@ -149,7 +150,7 @@ pub fn limiting_depth<S: StabilitySolver + ?Sized>(
         MAX_REFINEMENT_STEPS,
         f,
     )?;
-    let depth_m = bracket.midpoint();
+    let depth_m = bracket.root();
     let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
     Ok(LobePoint {
         speed_rpm,

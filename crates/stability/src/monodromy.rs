@@ -34,8 +34,8 @@
 //! O(M^2 N^3) only when all eigenpairs are needed (sensitivities, cross-checks).
 
 use crate::StabilitySolver;
+use crate::eigen::{dense_eigenvalues, hessenberg_eigenvalues_robust};
 use crate::error::{Result, StabilityError, check_condition};
-use crate::hessenberg::hessenberg_eigenvalues;
 use crate::multiplier::DominantMultiplier;
 use chatter_dynamics::{ModalModel, Operation};
 use nalgebra::{DMatrix, DVector};
@@ -683,34 +683,40 @@ impl Monodromy {
     }
 
     /// The eigenvalue of largest modulus, by restarted Arnoldi on the matrix-free operator
-    /// (dense eigenvalues for tiny operators).
+    /// (dense eigenvalues for tiny operators; see [`Self::dominant_eigenpair`] for the
+    /// fallbacks).
     pub fn dominant_eigenvalue(&self) -> Result<Complex64> {
         let d = self.dimension();
-        if d <= 24 {
-            return largest(&self.dense().complex_eigenvalues());
+        if d <= DENSE_MAX_DIM {
+            return largest(&dense_eigenvalues(&self.dense())?);
         }
-        Ok(arnoldi(|x, out| self.apply(x, out), d)?.0)
+        Ok(self.dominant_eigenpair()?.0)
     }
 }
 
 impl Monodromy {
     /// The dominant eigenvalue and its (complex) eigenvector.
+    ///
+    /// Restarted Arnoldi on the matrix-free operator; when it does not converge, a second run
+    /// with a larger Krylov space, more restarts and another start vector; when that fails too,
+    /// the dense operator (up to [`DENSE_FALLBACK_MAX_DIM`]). Tiny operators go to the dense
+    /// solver directly.
     pub fn dominant_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
-        let d = self.dimension();
-        if d > 24 {
-            return arnoldi(|x, out| self.apply(x, out), d);
-        }
-        dense_eigenpair(self.dense())
+        robust_eigenpair(
+            |x, out| self.apply(x, out),
+            self.dimension(),
+            || self.dense(),
+        )
     }
 
     /// The dominant eigenvalue and its left eigenvector v (U^T v = mu v), from the transposed
-    /// operator.
+    /// operator (with the fallbacks of [`Self::dominant_eigenpair`]).
     pub fn dominant_left_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
-        let d = self.dimension();
-        if d > 24 {
-            return arnoldi(|x, out| self.apply_transpose(x, out), d);
-        }
-        dense_eigenpair(self.dense().transpose())
+        robust_eigenpair(
+            |x, out| self.apply_transpose(x, out),
+            self.dimension(),
+            || self.dense().transpose(),
+        )
     }
 
     /// Chatter frequency (Hz) of the dominant eigenfunction: among the family f_mu + k / tau
@@ -764,10 +770,39 @@ impl Monodromy {
     }
 }
 
+/// Largest operator dimension solved densely from the start.
+const DENSE_MAX_DIM: usize = 24;
+/// Largest operator dimension for which a failed Arnoldi iteration falls back to the dense
+/// operator (building it costs `d` applications, its eigenvalues O(d^3): about 0.1 s at 600).
+pub const DENSE_FALLBACK_MAX_DIM: usize = 600;
+
+/// The dominant eigenpair of the operator `apply` of dimension `d`: dense for tiny operators,
+/// else Arnoldi, a larger Arnoldi and the dense matrix `dense()` in turn.
+fn robust_eigenpair<F: Fn(&[f64], &mut [f64])>(
+    apply: F,
+    d: usize,
+    dense: impl Fn() -> DMatrix<f64>,
+) -> Result<(Complex64, Vec<Complex64>)> {
+    if d <= DENSE_MAX_DIM {
+        return dense_eigenpair(dense());
+    }
+    let first = match arnoldi(&apply, d, &ArnoldiConfig::DEFAULT) {
+        Ok(pair) => return Ok(pair),
+        Err(e) => e,
+    };
+    if let Ok(pair) = arnoldi(&apply, d, &ArnoldiConfig::FALLBACK) {
+        return Ok(pair);
+    }
+    if d <= DENSE_FALLBACK_MAX_DIM {
+        return dense_eigenpair(dense());
+    }
+    Err(first)
+}
+
 /// Dominant eigenvalue of a small dense matrix and its eigenvector by inverse iteration.
 fn dense_eigenpair(dense: DMatrix<f64>) -> Result<(Complex64, Vec<Complex64>)> {
     let d = dense.nrows();
-    let mu = largest(&dense.complex_eigenvalues())?;
+    let mu = largest(&dense_eigenvalues(&dense)?)?;
     let shift = mu * Complex64::new(1.0 + 1e-10, 0.0);
     let lu = (dense.map(|x| Complex64::new(x, 0.0)) - DMatrix::identity(d, d) * shift).lu();
     let mut x = DVector::from_element(d, Complex64::new(1.0, 0.0));
@@ -781,7 +816,7 @@ fn dense_eigenpair(dense: DMatrix<f64>) -> Result<(Complex64, Vec<Complex64>)> {
 }
 
 /// The eigenvalue of largest modulus; of a complex-conjugate pair, the member with Im >= 0.
-fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
+fn largest(values: &[Complex64]) -> Result<Complex64> {
     let finite = || {
         values
             .iter()
@@ -805,26 +840,46 @@ fn largest(values: &DVector<Complex64>) -> Result<Complex64> {
         })
 }
 
-/// Krylov dimension of one Arnoldi cycle.
-const ARNOLDI_DIM: usize = 20;
-/// Krylov dimensions within a cycle at which convergence is tested (the small Hessenberg
-/// eigenproblem costs O(k^3), so most operators stop well before [`ARNOLDI_DIM`]).
-const ARNOLDI_CHECKS: [usize; 4] = [8, 12, 16, ARNOLDI_DIM];
-/// Maximum restarts.
-const ARNOLDI_RESTARTS: usize = 40;
+/// One Arnoldi configuration: Krylov dimension of a cycle, the dimensions within a cycle at
+/// which convergence is tested (the small Hessenberg eigenproblem costs O(k^3), so most operators
+/// stop well before the full dimension), the restarts, and the phase of the start vector.
+struct ArnoldiConfig {
+    dim: usize,
+    checks: &'static [usize],
+    restarts: usize,
+    start_phase: f64,
+}
+
+impl ArnoldiConfig {
+    /// The configuration of every first attempt.
+    const DEFAULT: Self = Self {
+        dim: 20,
+        checks: &[8, 12, 16, 20],
+        restarts: 40,
+        start_phase: 0.7,
+    };
+    /// The second attempt when the first does not converge: twice the Krylov space, three
+    /// times the restarts, another start vector.
+    const FALLBACK: Self = Self {
+        dim: 40,
+        checks: &[10, 20, 30, 40],
+        restarts: 120,
+        start_phase: 2.3,
+    };
+}
+
 /// Relative convergence of the dominant Ritz value between restarts and by residual.
 const ARNOLDI_TOL: f64 = 1e-10;
+/// A new Krylov direction shorter than this fraction of the operator's image counts as a
+/// breakdown (the Krylov space is invariant to round-off): continuing would fill the Hessenberg
+/// matrix with noise.
+const ARNOLDI_BREAKDOWN: f64 = 1e-12;
 
 /// The dominant Ritz pair of the leading kk x kk block of `h`: value, the small eigenvector and
 /// the residual estimate |h_{kk+1,kk} x_kk|.
 fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex64>, f64)> {
-    let mut rows: Vec<f64> = (0..kk * kk).map(|k| h[(k / kk, k % kk)]).collect();
-    let values =
-        hessenberg_eigenvalues(&mut rows, kk).ok_or_else(|| StabilityError::NoConvergence {
-            solver: "Hessenberg QR",
-            detail: format!("{kk} x {kk} Arnoldi matrix"),
-        })?;
-    let theta = largest(&DVector::from_vec(values))?;
+    let (values, _) = hessenberg_eigenvalues_robust(kk, |i, j| h[(i, j)])?;
+    let theta = largest(&values)?;
     // Ritz vector of theta by inverse iteration on the small Hessenberg matrix
     let hc = h.view((0, 0), (kk, kk)).map(|x| Complex64::new(x, 0.0));
     let shift = theta * Complex64::new(1.0 + 1e-10, 0.0);
@@ -846,12 +901,16 @@ fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex6
 
 /// Restarted Arnoldi for the eigenvalue of largest modulus of the operator `apply` of dimension
 /// `d`, with its Ritz vector. Convergence is tested at the Krylov dimensions of
-/// [`ARNOLDI_CHECKS`]; a cycle that reaches [`ARNOLDI_DIM`] restarts from its Ritz vector.
-fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, Vec<Complex64>)> {
-    let k = ARNOLDI_DIM.min(d - 1);
+/// `config.checks`; a cycle that reaches `config.dim` restarts from its Ritz vector.
+fn arnoldi<F: Fn(&[f64], &mut [f64])>(
+    apply: F,
+    d: usize,
+    config: &ArnoldiConfig,
+) -> Result<(Complex64, Vec<Complex64>)> {
+    let k = config.dim.min(d - 1);
     // deterministic start vector
     let mut start: Vec<f64> = (0..d)
-        .map(|i| 1.0 + 0.5 * ((i as f64) * 0.7).sin())
+        .map(|i| 1.0 + 0.5 * ((i as f64) * config.start_phase).sin())
         .collect();
     let mut previous: Option<Complex64> = None;
     let mut v = vec![vec![0.0; d]; k + 1];
@@ -861,7 +920,7 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
             .map(|i| (0..kk).map(|j| x[j] * v[j][i]).sum())
             .collect()
     };
-    for _ in 0..ARNOLDI_RESTARTS {
+    for _ in 0..config.restarts {
         let norm = start.iter().map(|x| x * x).sum::<f64>().sqrt();
         for (vi, si) in v[0].iter_mut().zip(&start) {
             *vi = si / norm;
@@ -872,6 +931,13 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
             // modified Gram-Schmidt, repeated when it cancels most of w (Daniel, Gragg,
             // Kaufman and Stewart 1976: reorthogonalize when the norm drops below 1/sqrt(2))
             let mut norm2 = w.iter().map(|x| x * x).sum::<f64>();
+            let image2 = norm2;
+            if !image2.is_finite() {
+                return Err(StabilityError::NoConvergence {
+                    solver: "Arnoldi",
+                    detail: "the operator overflowed".into(),
+                });
+            }
             for _ in 0..2 {
                 let before = norm2;
                 for (i, vi) in v.iter().enumerate().take(j + 1) {
@@ -889,13 +955,13 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
             let beta = norm2.sqrt();
             h[(j + 1, j)] = beta;
             let kk = j + 1;
-            let breakdown = beta < 1e-14;
+            let breakdown = beta < 1e-14 || beta <= ARNOLDI_BREAKDOWN * image2.sqrt();
             if !breakdown {
                 for (vx, wx) in v[j + 1].iter_mut().zip(&w) {
                     *vx = wx / beta;
                 }
             }
-            if !(breakdown || kk == k || ARNOLDI_CHECKS.contains(&kk)) {
+            if !(breakdown || kk == k || config.checks.contains(&kk)) {
                 continue;
             }
             let (theta, x, residual) = ritz_pair(&h, kk)?;
@@ -916,7 +982,10 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(apply: F, d: usize) -> Result<(Complex64, 
     }
     Err(StabilityError::NoConvergence {
         solver: "Arnoldi",
-        detail: format!("{ARNOLDI_RESTARTS} restarts"),
+        detail: format!(
+            "{} restarts of a {k}-dimensional Krylov space",
+            config.restarts
+        ),
     })
 }
 
@@ -939,7 +1008,7 @@ mod tests {
             ] {
                 let op = method.monodromy(&model, rpm, b).unwrap();
                 let fast = op.dominant_eigenvalue().unwrap();
-                let dense = largest(&op.dense().complex_eigenvalues()).unwrap();
+                let dense = largest(&dense_eigenvalues(&op.dense()).unwrap()).unwrap();
                 // the monodromy is far from normal: dense QR eigenvalues carry ~1e-8 errors
                 assert!(
                     (fast - dense).norm() < 1e-7 * dense.norm(),
@@ -979,6 +1048,35 @@ mod tests {
                 let left = op.dominant_left_eigenpair().unwrap().0;
                 assert!((left.norm() - right.norm()).abs() < 1e-9 * right.norm());
             }
+        }
+    }
+
+    /// The fallback chain of [`robust_eigenpair`] on an operator (a diagonal one of dimension 60
+    /// with dominant eigenvalue 0.9) that overflows on its first `bad` applications: one bad
+    /// application fails the first Arnoldi run and the second one converges; an operator that
+    /// always overflows fails both and the dense matrix answers. Either way the dominant
+    /// eigenvalue is 0.9 to 1e-10.
+    #[test]
+    fn failed_arnoldi_falls_back() {
+        let d = 60;
+        let diagonal = |i: usize| 0.9 * (1.0 - i as f64 / d as f64);
+        for bad in [1, usize::MAX] {
+            let calls = std::cell::Cell::new(0usize);
+            let apply = |x: &[f64], out: &mut [f64]| {
+                calls.set(calls.get() + 1);
+                for (i, (o, xi)) in out.iter_mut().zip(x).enumerate() {
+                    *o = if calls.get() <= bad {
+                        f64::NAN
+                    } else {
+                        diagonal(i) * xi
+                    };
+                }
+            };
+            assert!(arnoldi(apply, d, &ArnoldiConfig::DEFAULT).is_err());
+            calls.set(0);
+            let dense = || DMatrix::from_fn(d, d, |i, j| if i == j { diagonal(i) } else { 0.0 });
+            let (mu, _) = robust_eigenpair(apply, d, dense).unwrap();
+            assert!((mu - 0.9).norm() < 1e-10, "{bad}: {mu}");
         }
     }
 

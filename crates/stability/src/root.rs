@@ -41,6 +41,16 @@ impl Bracket {
         0.5 * (self.negative + self.positive)
     }
 
+    /// The root the bracket stands for: its positive end where f vanishes exactly there (a
+    /// false-position step that lands on the root), else its midpoint.
+    pub fn root(&self) -> f64 {
+        if self.f_positive == 0.0 {
+            self.positive
+        } else {
+            self.midpoint()
+        }
+    }
+
     /// Whether the bracket is at most `relative_tolerance` of its larger end wide, or f vanishes
     /// at its positive end.
     fn converged(&self, relative_tolerance: f64) -> bool {
@@ -138,6 +148,16 @@ mod tests {
         )
         .unwrap();
         assert!((b.midpoint() - 1.0).abs() < 1e-11);
+    }
+
+    /// A linear function: the first false-position step lands on the root exactly (f = 0), and
+    /// the root is that point, not the midpoint of the bracket it leaves.
+    #[test]
+    fn exact_hit_is_the_root() {
+        let f = |x: f64| Ok::<_, Infallible>(0.5 * x - 0.5);
+        let b = illinois(Bracket::new((0.0, -0.5), (1.25, 0.125)), 1e-4, 100, f).unwrap();
+        assert_eq!(b.f_positive, 0.0);
+        assert_eq!(b.root(), 1.0);
     }
 
     #[test]
