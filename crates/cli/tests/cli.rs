@@ -907,6 +907,7 @@ fn detect_labels_simulated_cuts() {
     .unwrap();
     let err = fail(chatter().args(["detect", "--observations", obs.to_str().unwrap()]));
     assert!(err.contains("sample_rate_hz"), "{err}");
+}
 
 /// `lobes --method zoa` honours the model's process damping (issue 14): on the 003-like flexure
 /// (228 Hz in x, 1 tooth, 50 % up milling, C = 2.5e5 N/m) the zero-order limit at 300 rpm is

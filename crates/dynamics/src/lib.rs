@@ -35,8 +35,8 @@ pub mod model_file;
 pub mod observations;
 pub mod operation;
 pub mod perturbation;
-pub mod sampled;
 mod resample;
+pub mod sampled;
 pub mod simulate;
 
 pub use error::{DynamicsError, Result};
