@@ -9,21 +9,9 @@ use num_complex::Complex64;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
 
-fn real(path: &str) -> Option<PathBuf> {
-    let p = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/real"
-    ))
-    .join(path);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} is absent", p.display());
-        None
-    }
-}
+mod common;
+use common::real;
 
 /// (frequency Hz, damping ratio, stiffness N/m)
 const MODES: [(f64, f64, f64); 3] = [

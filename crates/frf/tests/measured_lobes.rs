@@ -8,21 +8,10 @@ use chatter_dynamics::{ModalModel, ModelFile, examples};
 use chatter_frf::uff::{Uff58Record, write_uff58};
 use chatter_frf::{Frf, MeasuredModel};
 use chatter_stability::zero_order::{ZeroOrderOptions, measured_limiting_depths, zoa_lobes};
-use std::path::{Path, PathBuf};
 
-fn real(path: &str) -> Option<PathBuf> {
-    let p = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/real"
-    ))
-    .join(path);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} is absent", p.display());
-        None
-    }
-}
+mod common;
+use common::real;
+use std::path::{Path, PathBuf};
 
 /// Write the model's xx, yy and xy FRFs as one UFF 58 file and a model file naming them.
 fn write_measured(model: &ModalModel, dir: &Path, grid: &[f64]) -> PathBuf {
