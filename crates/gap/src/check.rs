@@ -64,11 +64,10 @@ pub(crate) fn predictive_check(
     for (s, pred) in predictions.iter().enumerate() {
         // labels: deviance of the data against replicated labels
         if !data.cuts.is_empty() {
-            let q: Vec<f64> = data
+            let q: Vec<f64> = pred
                 .cuts
                 .iter()
-                .zip(&pred.cuts)
-                .map(|(_, q)| noise.chatter_probability(q.map_or(f64::NAN, |q| q.log_distance())))
+                .map(|q| noise.chatter_probability(q.map_or(f64::NAN, |q| q.log_distance())))
                 .collect();
             let deviance = |unstable: &dyn Fn(usize) -> bool| -> f64 {
                 q.iter()

@@ -23,6 +23,7 @@ use crate::error::{GapError, Result};
 use crate::variant::{Variant, recalibrated};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{ModalModel, Mode, ModeShape};
+use chatter_stability::boundary::dominant_mode_frequency_hz;
 use chatter_stability::process_damping::{average_normal_projector, damping_ratio_slope_per_m};
 use chatter_stability::zero_order::zoa_limiting_depth;
 use serde::{Deserialize, Serialize};
@@ -107,17 +108,8 @@ pub(crate) struct Nominal {
 impl Nominal {
     /// The nominal model; `speeds` are the observed speeds (rpm) that scale the priors.
     pub fn new(model: &ModalModel, speeds: &[f64]) -> Result<Self> {
-        let a = model.average_directional_matrix();
-        let a = [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]];
-        let dominant = model
-            .modes()
-            .iter()
-            .max_by(|x, y| weight(x, &a).total_cmp(&weight(y, &a)))
-            .ok_or_else(|| GapError::Model("no modes".into()))?;
+        let (dominant, reference_stiffness_n_per_m) = dominant_mode(model)?;
         let reference_hz = dominant.frequency_hz();
-        let phi = dominant.mass_normalized_shape();
-        let reference_stiffness_n_per_m =
-            dominant.omega_rad_s().powi(2) / (phi[0].powi(2) + phi[1].powi(2));
         let max_speed_rpm = speeds.iter().copied().fold(0.0, f64::max);
         let min_speed_rpm = speeds.iter().copied().fold(f64::INFINITY, f64::min);
         if !(max_speed_rpm > 0.0 && min_speed_rpm.is_finite()) {
@@ -169,11 +161,24 @@ impl Nominal {
     }
 }
 
-/// Oriented modal weight phi^T A phi / (zeta omega^2) of a mode (its share of chatter).
-fn weight(m: &Mode, a: &[[f64; 2]; 2]) -> f64 {
-    let p = m.mass_normalized_shape();
-    let q = p[0] * (a[0][0] * p[0] + a[0][1] * p[1]) + p[1] * (a[1][0] * p[0] + a[1][1] * p[1]);
-    q / (m.damping_ratio().max(1e-6) * m.omega_rad_s().powi(2))
+/// The mode that dominates regenerative chatter (the one whose frequency
+/// [`dominant_mode_frequency_hz`] picks) with its modal stiffness omega^2 / |phi|^2 (N/m).
+pub(crate) fn dominant_mode(model: &ModalModel) -> Result<(&Mode, f64)> {
+    let f_ref = dominant_mode_frequency_hz(model);
+    let mode = model
+        .modes()
+        .iter()
+        .min_by(|a, b| {
+            (a.frequency_hz() - f_ref)
+                .abs()
+                .total_cmp(&(b.frequency_hz() - f_ref).abs())
+        })
+        .ok_or_else(|| GapError::Model("no modes".into()))?;
+    let phi = mode.mass_normalized_shape();
+    Ok((
+        mode,
+        mode.omega_rad_s().powi(2) / (phi[0].powi(2) + phi[1].powi(2)),
+    ))
 }
 
 /// A class ready for the sampler: prior and the map from parameters to a machine.

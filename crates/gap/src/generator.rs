@@ -30,7 +30,7 @@
 //! # Ok::<(), chatter_gap::GapError>(())
 //! ```
 
-use crate::classes::EffectClass;
+use crate::classes::{EffectClass, dominant_mode};
 use crate::error::{GapError, Result, positive};
 use crate::predict::observed_pole;
 use crate::variant::{CuttingBand, Variant, recalibrated};
@@ -39,7 +39,7 @@ use chatter_dynamics::{
     Operation, PoleObservation, Turning,
 };
 use chatter_stability::StabilitySolver;
-use chatter_stability::boundary::{BoundaryOptions, dominant_mode_frequency_hz, limiting_depth};
+use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::{Discretization, StepsPerDelay};
 use num_complex::Complex64;
 use rand::rngs::StdRng;
@@ -465,18 +465,9 @@ pub fn effect_at(
     speed_range_rpm: (f64, f64),
 ) -> Result<(HiddenEffect, Recalibration)> {
     let none = Recalibration::default();
-    let f_ref = dominant_mode_frequency_hz(nominal);
-    let dominant = nominal
-        .modes()
-        .iter()
-        .min_by(|a, b| {
-            (a.frequency_hz() - f_ref)
-                .abs()
-                .total_cmp(&(b.frequency_hz() - f_ref).abs())
-        })
-        .ok_or_else(|| GapError::Model("no modes".into()))?;
+    let (dominant, k_ref) = dominant_mode(nominal)?;
+    let f_ref = dominant.frequency_hz();
     let phi = dominant.mass_normalized_shape();
-    let k_ref = dominant.omega_rad_s().powi(2) / (phi[0].powi(2) + phi[1].powi(2));
     Ok(match class {
         EffectClass::ParameterError => (
             HiddenEffect::ParameterError,
