@@ -9,12 +9,11 @@
 //! --classes drift --cuts 40 --samples 120 --steps 1]`
 
 use chatter_gap::generator::{effect_at, proving_machines, true_variant};
+use chatter_gap::predict::inference_solver;
 use chatter_gap::{
     DiagnoseOptions, DiagnosisObserver, EffectClass, HiddenEffect, Recalibration, Scenario,
     Validation, Variant, diagnose, synthesize,
 };
-use chatter_stability::StabilitySolver;
-use chatter_stability::monodromy::Discretization;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -31,10 +30,10 @@ fn list<T: std::str::FromStr>(name: &str, default: Vec<T>) -> Vec<T> {
     })
 }
 
-/// Whether `variant` predicts chatter at a cut (full discretization), None on failure.
+/// Whether `variant` predicts chatter at a cut (the inference's solver), None on failure.
 fn chatters(variant: &Variant, speed_rpm: f64, depth_m: f64, u: f64) -> Option<bool> {
     let model = variant.at(None, speed_rpm, u).ok()?;
-    let mu = Discretization::full()
+    let mu = inference_solver(&model)
         .dominant_multiplier(&model, speed_rpm, depth_m)
         .ok()?;
     Some(mu.modulus() > 1.0)

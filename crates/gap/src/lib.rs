@@ -30,10 +30,11 @@
 //! # Model: which approximation is used where
 //! - **Inside the samplers and the checks** every prediction is one Floquet multiplier of the
 //!   variant's own periodic delay equation at the observation's cutting condition
-//!   ([`predict`]): the first-order full discretization of `chatter-stability` at its automatic
-//!   resolution. No limiting depth is searched and no averaged (zero-order) system is used.
-//!   Against the proving ground's truth it errs by at most 0.6 % in limiting depth on the test
-//!   machines (`tests/proving_ground.rs`), well inside the label width (8 % in depth).
+//!   ([`predict`]): for milling the first-order full discretization of `chatter-stability` at
+//!   its automatic resolution, for turning (constant coefficients) the rightmost root of the
+//!   characteristic equation. No limiting depth is searched and no averaged (zero-order) system
+//!   is used. Against the proving ground's truth it errs by at most 0.6 % in limiting depth on
+//!   the test machines (`tests/proving_ground.rs`), well inside the label width (8 % in depth).
 //! - **The label model** interpolates ln|mu| linearly in depth between b = 0 and the cut to
 //!   turn ln|mu| into a log-depth distance (exact at the boundary, approximate away from it,
 //!   where it only shapes the probit's width).

@@ -1,10 +1,14 @@
 //! What a machine variant predicts for each observation, from the Floquet multiplier of the
 //! periodic delay equation at the observation's own cutting condition.
 //!
-//! Every prediction is one dominant multiplier mu of the first-order full discretization
-//! (`chatter_stability::monodromy`, 000 Eq. 9-11, automatic resolution: at least 40 steps and 24
-//! steps per vibration period of the highest mode while cutting) of the variant's model at the
-//! cut's speed, depth, radial immersion and campaign position. No limiting depth is searched:
+//! Every prediction is one dominant multiplier mu of the variant's model at the cut's speed,
+//! depth, radial immersion and campaign position ([`inference_solver`]): for milling the
+//! first-order full discretization (`chatter_stability::monodromy`, 000 Eq. 9-11, automatic
+//! resolution: at least 40 steps and 24 steps per vibration period of the highest mode while
+//! cutting); for turning, whose delay equation has constant coefficients, mu = e^{lambda tau}
+//! of the rightmost characteristic root found by Newton's method
+//! (`chatter_stability::frequency_domain`, exact up to the root search: no discretization).
+//! No limiting depth is searched:
 //! - a **cut** is described by ln|mu| at its depth and by ln|mu_0| = -min_n zeta_n w_n tau, the
 //!   multiplier without cutting. Linear interpolation of ln|mu| in depth between b = 0 and the
 //!   cut places the boundary at b_lim = b ln|mu_0| / (ln|mu_0| - ln|mu|), so the signed
@@ -31,6 +35,7 @@ use crate::data::Dataset;
 use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
+use chatter_stability::frequency_domain::FrequencyDomain;
 use chatter_stability::monodromy::Discretization;
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -84,9 +89,15 @@ impl Prediction {
     }
 }
 
-/// The solver of every prediction.
-fn solver() -> Discretization {
-    Discretization::full()
+/// The solver of every prediction for `model`: the exact characteristic roots of the
+/// autonomous delay equation for turning ([`FrequencyDomain`], 000 Eq. 5-6), the first-order
+/// full discretization at its automatic resolution for milling (periodic coefficients).
+pub fn inference_solver(model: &ModalModel) -> Box<dyn StabilitySolver> {
+    if milling(model) {
+        Box::new(Discretization::full())
+    } else {
+        Box::new(FrequencyDomain)
+    }
 }
 
 /// ln|mu| without cutting: the slowest free decay over one delay.
@@ -114,7 +125,7 @@ pub(crate) fn predict_cut(
 ) -> Option<CutPrediction> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
     let tau = model.operation().delay_s(speed_rpm);
-    let s = solver();
+    let s = inference_solver(&model);
     let (mu, chatter_hz) = if with_frequency && !milling(&model) {
         s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?
     } else {
@@ -138,7 +149,7 @@ pub(crate) fn predict_pole(
     u: f64,
 ) -> Option<PredictedPole> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
-    let s = solver();
+    let s = inference_solver(&model);
     let (mu, physical_hz) = if milling(&model) {
         let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
         (mu, mu.principal_frequency_hz())

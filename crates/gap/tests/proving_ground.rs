@@ -7,15 +7,15 @@
 //!    between the first-order full and semi-discretizations at the automatic resolution.
 //! 2. The single-DOF turning boundary in closed form (Tlusty): b_lim = -1 / (2 K Re G(w_c))
 //!    at the frequencies where the phase condition holds; the truth within 0.5 %.
-//! 3. The approximation error of the inference's solver (full discretization, automatic
-//!    resolution) against the truth on every proving machine, the figure the crate docs quote:
-//!    within 3 % in limiting depth.
+//! 3. The approximation error of the inference's solver (full discretization at the automatic
+//!    resolution for milling, the characteristic roots for turning) against the truth on every
+//!    proving machine, the figure the crate docs quote: within 3 % in limiting depth.
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::{CuttingCoefficients, ModalModel, Mode, ModeShape, Operation, Turning};
 use chatter_gap::generator::{proving_machines, true_limiting_depth};
+use chatter_gap::predict::inference_solver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::Discretization;
 use std::f64::consts::PI;
 
 /// Growth factor per delay of a perturbation of the delay equation of `model` at a cut,
@@ -201,7 +201,7 @@ fn the_inference_solver_errs_by_at_most_3_percent_in_depth() {
             let speed = lo + (hi - lo) * (i as f64 + 0.5) / 5.0;
             let truth = true_limiting_depth(&machine.model, speed).unwrap();
             let fast = limiting_depth(
-                &Discretization::full(),
+                inference_solver(&machine.model).as_ref(),
                 &machine.model,
                 speed,
                 &BoundaryOptions::default(),
