@@ -525,10 +525,32 @@ pub fn effect_at(
     })
 }
 
-/// One entry of the run order: a test cut or a pole identification.
-enum Entry {
-    Cut { speed_rpm: f64, depth_m: f64 },
-    Pole { speed_rpm: f64, fraction: f64 },
+/// What a test of the run order measures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlannedKind {
+    /// A test cut, labelled stable or chatter (with its chatter frequency).
+    Cut,
+    /// A stable cut whose dominant pole is identified; its depth is a fraction of the true
+    /// limiting depth at its speed and campaign position.
+    Pole {
+        /// Depth as a fraction of the true limiting depth.
+        fraction: f64,
+    },
+}
+
+/// One test of a campaign's run order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlannedTest {
+    /// What it measures.
+    pub kind: PlannedKind,
+    /// Spindle speed (rpm).
+    pub speed_rpm: f64,
+    /// Depth (m): the cut's depth, or for a pole the fraction times the true limit.
+    pub depth_m: f64,
+    /// Campaign position in [0, 1] (drift).
+    pub position: f64,
+    /// Run-order number when the scenario records it.
+    pub sequence: Option<i64>,
 }
 
 /// ln|mu| and the frequency of the dominant multiplier of the truth at a cut, with the
@@ -542,8 +564,17 @@ fn truth_at(model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<(f64, f6
     Ok((mu.modulus().ln(), f, lambda))
 }
 
-/// Synthetic observations of `scenario` on the machine whose nominal model is `nominal`.
-pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observations> {
+/// The run order of `scenario` on the machine `nominal`: cuts at `scenario.speeds` random
+/// speeds with depths log-uniform in `depth_ratio_range` times the nominal limit (capped at
+/// 50 mm), pole tests at `pole_speeds_rpm` x `pole_depth_fractions` of the true limit, shuffled.
+/// The same plan whoever observes it: [`synthesize`] from the exact truth, or a test that
+/// simulates every cut and reads it as a shop would.
+pub fn campaign_plan(nominal: &ModalModel, scenario: &Scenario) -> Result<Vec<PlannedTest>> {
+    let mut rng = StdRng::seed_from_u64(scenario.seed);
+    plan(nominal, scenario, &mut rng)
+}
+
+fn plan(nominal: &ModalModel, scenario: &Scenario, rng: &mut StdRng) -> Result<Vec<PlannedTest>> {
     let truth = true_variant(nominal, scenario)?;
     let (lo, hi) = scenario.speed_range_rpm;
     positive("speed_range_rpm.0", lo)?;
@@ -557,7 +588,6 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
     let (r_lo, r_hi) = scenario.depth_ratio_range;
     positive("depth_ratio_range.0", r_lo)?;
     positive("depth_ratio_range.1", r_hi)?;
-    let mut rng = StdRng::seed_from_u64(scenario.seed);
     let speeds: Vec<f64> = (0..scenario.speeds.max(1))
         .map(|_| lo + (hi - lo) * rng.random::<f64>())
         .collect();
@@ -565,35 +595,58 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
         .iter()
         .map(|&s| Ok(true_limiting_depth(nominal, s)?.min(0.05)))
         .collect::<Result<Vec<f64>>>()?;
-    let mut entries = Vec::new();
+    let mut tests = Vec::new();
     for k in 0..scenario.cuts {
         let i = k % speeds.len();
         let ratio = (r_lo.ln() + (r_hi / r_lo).ln() * rng.random::<f64>()).exp();
-        entries.push(Entry::Cut {
-            speed_rpm: speeds[i],
-            depth_m: ratio * limits[i],
-        });
+        tests.push((PlannedKind::Cut, speeds[i], ratio * limits[i]));
     }
     for &speed_rpm in &scenario.pole_speeds_rpm {
         positive("pole_speeds_rpm", speed_rpm)?;
         for &fraction in &scenario.pole_depth_fractions {
-            entries.push(Entry::Pole {
-                speed_rpm,
-                fraction: positive("pole_depth_fractions", fraction)?,
-            });
+            let fraction = positive("pole_depth_fractions", fraction)?;
+            tests.push((PlannedKind::Pole { fraction }, speed_rpm, f64::NAN));
         }
     }
-    entries.shuffle(&mut rng);
-    let n = entries.len().max(2);
+    tests.shuffle(rng);
+    let n = tests.len().max(2);
+    tests
+        .into_iter()
+        .enumerate()
+        .map(|(k, (kind, speed_rpm, depth_m))| {
+            let position = k as f64 / (n - 1) as f64;
+            let depth_m = match kind {
+                PlannedKind::Cut => depth_m,
+                PlannedKind::Pole { fraction } => {
+                    let model = truth.at(None, speed_rpm, position)?;
+                    fraction * true_limiting_depth(&model, speed_rpm)?.min(0.05)
+                }
+            };
+            Ok(PlannedTest {
+                kind,
+                speed_rpm,
+                depth_m,
+                position,
+                sequence: (scenario.run_order == RunOrder::Recorded).then_some(k as i64 + 1),
+            })
+        })
+        .collect()
+}
+
+/// Synthetic observations of `scenario` on the machine whose nominal model is `nominal`: the
+/// [`campaign_plan`] observed through the exact truth with the scenario's noise.
+pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observations> {
+    let truth = true_variant(nominal, scenario)?;
+    let mut rng = StdRng::seed_from_u64(scenario.seed);
+    let tests = plan(nominal, scenario, &mut rng)?;
     let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
     let milling = matches!(nominal.operation(), Operation::Milling(_));
     let mut obs = Observations::default();
-    for (k, entry) in entries.iter().enumerate() {
-        let u = k as f64 / (n - 1) as f64;
-        let sequence = (scenario.run_order == RunOrder::Recorded).then_some(k as i64 + 1);
-        match *entry {
-            Entry::Cut { speed_rpm, depth_m } => {
-                let model = truth.at(None, speed_rpm, u)?;
+    for test in &tests {
+        let (speed_rpm, depth_m, sequence) = (test.speed_rpm, test.depth_m, test.sequence);
+        let model = truth.at(None, speed_rpm, test.position)?;
+        match test.kind {
+            PlannedKind::Cut => {
                 let jittered = depth_m * (scenario.label_width_log_depth * normal()).exp();
                 let (ln_mu, _, _) = truth_at(&model, speed_rpm, jittered)?;
                 let stable = ln_mu < 0.0;
@@ -613,12 +666,7 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
                     note: None,
                 });
             }
-            Entry::Pole {
-                speed_rpm,
-                fraction,
-            } => {
-                let model = truth.at(None, speed_rpm, u)?;
-                let depth_m = fraction * true_limiting_depth(&model, speed_rpm)?.min(0.05);
+            PlannedKind::Pole { .. } => {
                 let (_, _, lambda) = truth_at(&model, speed_rpm, depth_m)?;
                 let tau = model.operation().delay_s(speed_rpm);
                 // a lifted pole: the principal value of ln(mu) / tau

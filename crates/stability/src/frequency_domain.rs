@@ -27,6 +27,9 @@ const CONTINUATION_STEPS: usize = 24;
 /// Newton iterations per step and their relative tolerance on lambda.
 const NEWTON_ITERATIONS: usize = 30;
 const NEWTON_TOL: f64 = 1e-13;
+/// Newton iterations from a grid start: a start a quarter of the root spacing from a root
+/// converges quadratically within a few; one that wanders is abandoned.
+const GRID_NEWTON_ITERATIONS: usize = 12;
 /// A relative Newton step below which a step that stops shrinking is round-off.
 const ROUND_OFF_TOL: f64 = 1e-10;
 
@@ -83,12 +86,13 @@ impl Characteristic {
         })
     }
 
-    /// Newton step 1 / tr(D^{-1} D') at width `a`.
+    /// Newton step 1 / tr(D^{-1} D') at width `a`. With one or two modes (most models inside
+    /// samplers) tr(D^{-1} D') = (det D)' / det D in closed form, without allocation.
     fn newton_step(&self, lambda: Complex64, a: f64) -> Option<Complex64> {
         let n = self.omegas.len();
         let e = (-lambda * self.tau).exp();
         let regen = Complex64::new(1.0, 0.0) - e;
-        let d = DMatrix::from_fn(n, n, |i, j| {
+        let entry = |i: usize, j: usize| {
             let mut v =
                 regen * a * self.coupling[(i, j)] + lambda * a * self.process_damping[(i, j)];
             if i == j {
@@ -97,28 +101,52 @@ impl Characteristic {
                     + self.omegas[i] * self.omegas[i];
             }
             v
-        });
-        let dd = DMatrix::from_fn(n, n, |i, j| {
+        };
+        let derivative = |i: usize, j: usize| {
             let mut v = e * a * self.tau * self.coupling[(i, j)] + a * self.process_damping[(i, j)];
             if i == j {
                 v += 2.0 * lambda + 2.0 * self.zetas[i] * self.omegas[i];
             }
             v
-        });
-        // an exactly singular D means lambda is already a root: no step
-        let Some(x) = d.lu().solve(&dd) else {
-            return Some(Complex64::new(0.0, 0.0));
         };
-        let tr = x.trace();
-        (tr.norm() > 0.0).then(|| Complex64::new(1.0, 0.0) / tr)
+        let (det, det_derivative) = match n {
+            1 => (entry(0, 0), derivative(0, 0)),
+            2 => {
+                let (d00, d01, d10, d11) = (entry(0, 0), entry(0, 1), entry(1, 0), entry(1, 1));
+                let (p00, p01, p10, p11) = (
+                    derivative(0, 0),
+                    derivative(0, 1),
+                    derivative(1, 0),
+                    derivative(1, 1),
+                );
+                (
+                    d00 * d11 - d01 * d10,
+                    p00 * d11 + d00 * p11 - p01 * d10 - d01 * p10,
+                )
+            }
+            _ => {
+                let d = DMatrix::from_fn(n, n, entry);
+                let dd = DMatrix::from_fn(n, n, derivative);
+                // an exactly singular D means lambda is already a root: no step
+                let Some(x) = d.lu().solve(&dd) else {
+                    return Some(Complex64::new(0.0, 0.0));
+                };
+                let tr = x.trace();
+                return (tr.norm() > 0.0).then(|| Complex64::new(1.0, 0.0) / tr);
+            }
+        };
+        if det.norm() == 0.0 {
+            return Some(Complex64::new(0.0, 0.0));
+        }
+        (det_derivative.norm() > 0.0).then(|| det / det_derivative)
     }
 
     /// Newton from `lambda` at width `a`; `None` when it does not converge. Converged when the
     /// step falls below `NEWTON_TOL` |lambda|, or below `ROUND_OFF_TOL` |lambda| without
     /// shrinking further (the round-off floor of det D near a multiple or clustered root).
-    fn newton(&self, mut lambda: Complex64, a: f64) -> Option<Complex64> {
+    fn newton(&self, mut lambda: Complex64, a: f64, iterations: usize) -> Option<Complex64> {
         let mut previous = f64::INFINITY;
-        for _ in 0..NEWTON_ITERATIONS {
+        for _ in 0..iterations {
             let step = self.newton_step(lambda, a)?;
             lambda -= step;
             if !(lambda.re.is_finite() && lambda.im.is_finite()) {
@@ -137,7 +165,7 @@ impl Characteristic {
         for k in 1..=CONTINUATION_STEPS {
             let a = width_m * k as f64 / CONTINUATION_STEPS as f64;
             lambda = self
-                .newton(lambda, a)
+                .newton(lambda, a, NEWTON_ITERATIONS)
                 .ok_or_else(|| StabilityError::NoConvergence {
                     solver: "characteristic-equation Newton",
                     detail: format!("width {a} m"),
@@ -168,12 +196,15 @@ pub fn closed_loop_poles(
 }
 
 /// The dominant (largest real part) closed-loop pole. Delay equations have infinitely many
-/// roots and the branch continued from a structural pole is not always the dominant one (nor
-/// does the continuation always succeed: at long delays e^{-lambda tau} is large at a damped
-/// pole and Newton's basin small), so Newton is also started from a grid around every mode
-/// (spacing a quarter of the spindle frequency, +-15 % of the natural frequency, on the
-/// structural pole's real part and on the imaginary axis) and the root with the largest real
-/// part wins. An error only when no start converges.
+/// roots; near each mode they form a chain spaced about 2 pi / tau in frequency. Continuing
+/// the structural pole in the width does not always end on the dominant root, nor always
+/// succeed (at long delays e^{-lambda tau} is large at a damped pole and Newton's basin
+/// small), so Newton is started on the imaginary axis, where stability is decided, on a grid
+/// around every mode (spacing a quarter of the spindle frequency, +-15 % of the natural
+/// frequency, at most 12 iterations each), and the root with the largest real part wins; an
+/// error only when no start converges. Checked against the first-order full discretization at
+/// 4000 steps (tests here) and against the semi-discretization at 4x resolution on the gap
+/// proving ground's turning machine (|mu| within 4e-4 from 0.3x to 2x the limiting depth).
 pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<ClosedLoopPole> {
     check_condition(speed_rpm, width_m)?;
     let ch = Characteristic::new(model, speed_rpm)?;
@@ -184,18 +215,12 @@ pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result
             best = Some(root);
         }
     };
-    for (&w, &z) in ch.omegas.iter().zip(&ch.zetas) {
-        let structural = Complex64::new(-z * w, w * (1.0 - z * z).sqrt());
-        if let Ok(root) = ch.continue_pole(structural, width_m) {
-            consider(root);
-        }
+    for &w in &ch.omegas {
         let k = (0.15 * w / spacing).ceil() as i64;
         for j in -k..=k {
-            for re in [-z * w, 0.0] {
-                let start = Complex64::new(re, w + j as f64 * spacing);
-                if let Some(root) = ch.newton(start, width_m) {
-                    consider(root);
-                }
+            let start = Complex64::new(0.0, w + j as f64 * spacing);
+            if let Some(root) = ch.newton(start, width_m, GRID_NEWTON_ITERATIONS) {
+                consider(root);
             }
         }
     }
