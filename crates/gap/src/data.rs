@@ -139,11 +139,13 @@ impl Dataset {
                 depth_m: p.depth_mm * 1e-3,
                 frequency_hz: p.frequency_hz,
                 damping_ratio: p.damping_ratio,
+                // the larger of the reported and the noise model's standard deviation: an
+                // identification's scatter over (overlapping) segments leaves out its bias
                 frequency_std_hz: p
                     .frequency_std_hz
-                    .filter(|s| *s > 0.0)
-                    .unwrap_or(noise.pole_frequency_std_fraction * reference_hz),
-                damping_std: p.damping_std.filter(|s| *s > 0.0).unwrap_or(
+                    .unwrap_or(0.0)
+                    .max(noise.pole_frequency_std_fraction * reference_hz),
+                damping_std: p.damping_std.unwrap_or(0.0).max(
                     noise.pole_damping_std_relative * p.damping_ratio.abs()
                         + noise.pole_damping_std_floor,
                 ),
@@ -237,7 +239,7 @@ mod tests {
                 frequency_hz: 80.0,
                 damping_ratio: 0.2,
                 frequency_std_hz: None,
-                damping_std: Some(0.01),
+                damping_std: Some(0.05),
                 repetitions: None,
                 sequence: Some(9),
                 radial_immersion: None,
@@ -256,7 +258,8 @@ mod tests {
         assert_eq!(data.requests.len(), 3);
         assert_eq!(data.cuts[3].request, data.cuts[0].request);
         assert!((data.poles[0].frequency_std_hz - 0.003 * 750.0).abs() < 1e-12);
-        assert_eq!(data.poles[0].damping_std, 0.01);
+        // a reported standard deviation above the noise model's floor (0.15 * 0.2 + 0.002) is kept
+        assert_eq!(data.poles[0].damping_std, 0.05);
         let sub = data.subset(&[2, 3], &[]);
         assert_eq!(sub.requests.len(), 2);
         assert_eq!(sub.cuts[1].request, 1);

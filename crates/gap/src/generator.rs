@@ -346,6 +346,14 @@ pub fn proving_machines() -> Result<Vec<ProvingMachine>> {
 
 /// The truth's solver for `model` at `speed_rpm` (see the module docs).
 pub fn truth_solver(model: &ModalModel, speed_rpm: f64) -> Result<Discretization> {
+    truth_solver_refined(model, speed_rpm, TRUTH_REFINEMENT)
+}
+
+fn truth_solver_refined(
+    model: &ModalModel,
+    speed_rpm: f64,
+    refinement: usize,
+) -> Result<Discretization> {
     let auto = Discretization::semi()
         .resolved(model, speed_rpm)
         .map_err(|e| GapError::Model(e.to_string()))?;
@@ -353,20 +361,39 @@ pub fn truth_solver(model: &ModalModel, speed_rpm: f64) -> Result<Discretization
         StepsPerDelay::Fixed(m) => m,
         StepsPerDelay::Auto => TRUTH_MIN_STEPS,
     };
-    Ok(Discretization::semi().with_steps((TRUTH_REFINEMENT * m).max(TRUTH_MIN_STEPS)))
+    Ok(Discretization::semi().with_steps((refinement * m).max(TRUTH_MIN_STEPS)))
+}
+
+/// `f` with the truth's solver; when its eigen-solver fails (Arnoldi can stall on clustered
+/// multipliers of a large operator), once more at five times the automatic resolution, an
+/// equally converged grid with another operator.
+fn with_truth<T>(
+    model: &ModalModel,
+    speed_rpm: f64,
+    f: impl Fn(&Discretization) -> chatter_stability::Result<T>,
+) -> Result<T> {
+    match f(&truth_solver(model, speed_rpm)?) {
+        Ok(v) => Ok(v),
+        Err(first) => f(&truth_solver_refined(
+            model,
+            speed_rpm,
+            TRUTH_REFINEMENT + 1,
+        )?)
+        .map_err(|e| GapError::Model(format!("{first}; at a finer grid: {e}"))),
+    }
 }
 
 /// The true limiting depth (m) of `model` at a speed; infinite where no lobe is below 1 m.
 pub fn true_limiting_depth(model: &ModalModel, speed_rpm: f64) -> Result<f64> {
-    let solver = truth_solver(model, speed_rpm)?;
     let options = BoundaryOptions {
         relative_tolerance: 1e-3,
         start_depth_m: 1e-4,
         ..BoundaryOptions::default()
     };
-    limiting_depth(&solver, model, speed_rpm, &options)
-        .map(|p| p.depth_m)
-        .map_err(|e| GapError::Model(format!("true limiting depth at {speed_rpm} rpm: {e}")))
+    with_truth(model, speed_rpm, |solver| {
+        limiting_depth(solver, model, speed_rpm, &options).map(|p| p.depth_m)
+    })
+    .map_err(|e| GapError::Model(format!("true limiting depth at {speed_rpm} rpm: {e}")))
 }
 
 /// The true machine of `scenario` over `nominal`.
@@ -556,10 +583,10 @@ pub struct PlannedTest {
 /// ln|mu| and the frequency of the dominant multiplier of the truth at a cut, with the
 /// continuous-time pole lambda it implies (physical frequency).
 fn truth_at(model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<(f64, f64, Complex64)> {
-    let solver = truth_solver(model, speed_rpm)?;
-    let (mu, f) = solver
-        .chatter_frequency_hz(model, speed_rpm, depth_m)
-        .map_err(|e| GapError::Model(format!("truth at {speed_rpm} rpm, {depth_m} m: {e}")))?;
+    let (mu, f) = with_truth(model, speed_rpm, |solver| {
+        solver.chatter_frequency_hz(model, speed_rpm, depth_m)
+    })
+    .map_err(|e| GapError::Model(format!("truth at {speed_rpm} rpm, {depth_m} m: {e}")))?;
     let lambda = Complex64::new(mu.modulus().ln() / mu.period_s, 2.0 * PI * f);
     Ok((mu.modulus().ln(), f, lambda))
 }

@@ -18,9 +18,11 @@
 //! - a **chattering cut**'s frequency is that of the dominant multiplier at the cut's own depth
 //!   (not at the boundary): the principal frequency arg(mu) / (2 pi tau) with its images
 //!   k / tau +- f_mu for milling, the eigenfunction's frequency for turning.
-//! - an identified **pole** at a stable cut is lambda = ln(mu) / tau: lifted over the tooth
-//!   period for milling (principal frequency |Im lambda| / 2 pi, damping -Re lambda / |lambda|,
-//!   as in 002), physical for turning (Im lambda from the eigenfunction's frequency, 000 Eq. 6).
+//! - an identified **pole** at a stable cut: for milling lambda = ln(mu) / tau of the dominant
+//!   multiplier, lifted over the tooth period (principal frequency |Im lambda| / 2 pi, damping
+//!   -Re lambda / |lambda|, as in 002); for turning the physical root (000 Eq. 6) near the mode
+//!   whose root lies closest in frequency to the identified one (mode pairing: an
+//!   identification of a two-mode lathe may report either mode's pole).
 //!
 //! # Accuracy
 //! Against the semi-discretization at four times the resolution (the proving ground's truth)
@@ -35,7 +37,7 @@ use crate::data::Dataset;
 use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
-use chatter_stability::frequency_domain::FrequencyDomain;
+use chatter_stability::frequency_domain::{FrequencyDomain, mode_poles};
 use chatter_stability::monodromy::Discretization;
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -141,23 +143,40 @@ pub(crate) fn predict_cut(
 }
 
 /// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).
+/// For milling it is the dominant multiplier's. For turning, where an identification of a
+/// multi-mode machine may lock onto a mode other than the least-damped one, it is the rightmost
+/// root near the mode closest in frequency to the identified `observed_hz` (mode pairing, as
+/// in modal updating); with one mode, or one mode dominating, that is the dominant root.
 pub(crate) fn predict_pole(
     variant: &Variant,
     speed_rpm: f64,
     depth_m: f64,
     immersion: Option<f64>,
     u: f64,
+    observed_hz: f64,
 ) -> Option<PredictedPole> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
-    let s = inference_solver(&model);
-    let (mu, physical_hz) = if milling(&model) {
-        let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
-        (mu, mu.principal_frequency_hz())
+    let pole = if milling(&model) {
+        let mu = Discretization::full()
+            .dominant_multiplier(&model, speed_rpm, depth_m)
+            .ok()?;
+        let lambda = Complex64::new(
+            mu.modulus().ln() / mu.period_s,
+            2.0 * PI * mu.principal_frequency_hz(),
+        );
+        observed_pole(lambda, true)
     } else {
-        s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?
+        mode_poles(&model, speed_rpm, depth_m)
+            .ok()?
+            .into_iter()
+            .flatten()
+            .map(|p| observed_pole(p.lambda, false))
+            .min_by(|a, b| {
+                (a.frequency_hz - observed_hz)
+                    .abs()
+                    .total_cmp(&(b.frequency_hz - observed_hz).abs())
+            })?
     };
-    let lambda = Complex64::new(mu.modulus().ln() / mu.period_s, 2.0 * PI * physical_hz);
-    let pole = observed_pole(lambda, milling(&model));
     (pole.frequency_hz.is_finite() && pole.damping_ratio.is_finite()).then_some(pole)
 }
 
@@ -192,7 +211,16 @@ pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
     let poles: Vec<Option<PredictedPole>> = data
         .poles
         .iter()
-        .map(|p| predict_pole(variant, p.speed_rpm, p.depth_m, immersion(p.geometry), p.u))
+        .map(|p| {
+            predict_pole(
+                variant,
+                p.speed_rpm,
+                p.depth_m,
+                immersion(p.geometry),
+                p.u,
+                p.frequency_hz,
+            )
+        })
         .collect();
     let failures =
         cuts.iter().filter(|c| c.is_none()).count() + poles.iter().filter(|p| p.is_none()).count();

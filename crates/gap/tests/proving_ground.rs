@@ -14,8 +14,8 @@
 
 use chatter_dynamics::{CuttingCoefficients, ModalModel, Mode, ModeShape, Operation, Turning};
 use chatter_gap::generator::{proving_machines, true_limiting_depth, truth_solver};
-use chatter_stability::StabilitySolver;
 use chatter_gap::predict::inference_solver;
+use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use std::f64::consts::PI;
 

@@ -45,7 +45,8 @@ fn record(
     duration_s: f64,
     seed: u64,
 ) -> Signals {
-    let mut settings = SimulationSettings::new(speed_rpm, depth_m, duration_s, SAMPLE_RATE_HZ, seed);
+    let mut settings =
+        SimulationSettings::new(speed_rpm, depth_m, duration_s, SAMPLE_RATE_HZ, seed);
     settings.harmonic_force_n = 5.0;
     let sim = simulate(model, &settings).unwrap();
     let mut rng = StdRng::seed_from_u64(seed ^ 0x5eed);
@@ -106,7 +107,10 @@ fn observe(nominal: &chatter_dynamics::ModalModel, scenario: &Scenario) -> Obser
                     ..IdentifyOptions::default()
                 };
                 let Ok(id) = identify(&signals, &options) else {
-                    eprintln!("pole at {:.0} rpm: identification failed, skipped", test.speed_rpm);
+                    eprintln!(
+                        "pole at {:.0} rpm: identification failed, skipped",
+                        test.speed_rpm
+                    );
                     continue;
                 };
                 let e = id.estimate;
@@ -149,7 +153,12 @@ fn run(effect: HiddenEffect, error: Recalibration, seed: u64) -> &'static str {
     for p in &data.poles {
         eprintln!(
             "pole {:.0} rpm {:.3} mm: {:.1} Hz ({:?}), zeta {:.4} ({:?})",
-            p.speed_rpm, p.depth_mm, p.frequency_hz, p.frequency_std_hz, p.damping_ratio, p.damping_std
+            p.speed_rpm,
+            p.depth_mm,
+            p.frequency_hz,
+            p.frequency_std_hz,
+            p.damping_ratio,
+            p.damping_std
         );
     }
     let options = DiagnoseOptions {
@@ -157,7 +166,15 @@ fn run(effect: HiddenEffect, error: Recalibration, seed: u64) -> &'static str {
         ..DiagnoseOptions::default()
     };
     let d = diagnose(&machine.model, &data, &options, &Quiet).unwrap();
-    eprintln!("verdict {} (expected {})", d.verdict.name(), effect.expected_verdict(&error));
+    eprintln!(
+        "verdict {} (expected {}); nominal check {:?}",
+        d.verdict.name(),
+        effect.expected_verdict(&error),
+        d.nominal_check
+    );
+    for c in &d.classes {
+        eprintln!("  {}: ln Z {:.1}", c.name, c.log_evidence);
+    }
     d.verdict.name()
 }
 

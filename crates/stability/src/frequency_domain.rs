@@ -164,12 +164,12 @@ impl Characteristic {
     fn continue_pole(&self, mut lambda: Complex64, width_m: f64) -> Result<Complex64> {
         for k in 1..=CONTINUATION_STEPS {
             let a = width_m * k as f64 / CONTINUATION_STEPS as f64;
-            lambda = self
-                .newton(lambda, a, NEWTON_ITERATIONS)
-                .ok_or_else(|| StabilityError::NoConvergence {
+            lambda = self.newton(lambda, a, NEWTON_ITERATIONS).ok_or_else(|| {
+                StabilityError::NoConvergence {
                     solver: "characteristic-equation Newton",
                     detail: format!("width {a} m"),
-                })?;
+                }
+            })?;
         }
         Ok(lambda)
     }
@@ -206,29 +206,42 @@ pub fn closed_loop_poles(
 /// 4000 steps (tests here) and against the semi-discretization at 4x resolution on the gap
 /// proving ground's turning machine (|mu| within 4e-4 from 0.3x to 2x the limiting depth).
 pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<ClosedLoopPole> {
-    check_condition(speed_rpm, width_m)?;
-    let ch = Characteristic::new(model, speed_rpm)?;
-    let spacing = 2.0 * PI / ch.tau / 4.0;
-    let mut best: Option<Complex64> = None;
-    let mut consider = |root: Complex64| {
-        if root.im > 0.0 && best.is_none_or(|b| root.re > b.re) {
-            best = Some(root);
-        }
-    };
-    for &w in &ch.omegas {
-        let k = (0.15 * w / spacing).ceil() as i64;
-        for j in -k..=k {
-            let start = Complex64::new(0.0, w + j as f64 * spacing);
-            if let Some(root) = ch.newton(start, width_m, GRID_NEWTON_ITERATIONS) {
-                consider(root);
-            }
-        }
-    }
-    best.map(ClosedLoopPole::new)
+    mode_poles(model, speed_rpm, width_m)?
+        .into_iter()
+        .flatten()
+        .max_by(|a, b| a.lambda.re.total_cmp(&b.lambda.re))
         .ok_or(StabilityError::NoConvergence {
             solver: "characteristic-equation Newton",
             detail: format!("no root found at {speed_rpm} rpm, width {width_m} m"),
         })
+}
+
+/// For every mode, the rightmost closed-loop root found from that mode's grid of starts (see
+/// [`dominant_pole`]; `None` where no start converged): the pole an identification sees near
+/// each mode. Their maximum by real part is the dominant pole.
+pub fn mode_poles(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+) -> Result<Vec<Option<ClosedLoopPole>>> {
+    check_condition(speed_rpm, width_m)?;
+    let ch = Characteristic::new(model, speed_rpm)?;
+    let spacing = 2.0 * PI / ch.tau / 4.0;
+    Ok(ch
+        .omegas
+        .iter()
+        .map(|&w| {
+            let k = (0.15 * w / spacing).ceil() as i64;
+            (-k..=k)
+                .filter_map(|j| {
+                    let start = Complex64::new(0.0, w + j as f64 * spacing);
+                    ch.newton(start, width_m, GRID_NEWTON_ITERATIONS)
+                })
+                .filter(|root| root.im > 0.0)
+                .max_by(|a, b| a.re.total_cmp(&b.re))
+                .map(ClosedLoopPole::new)
+        })
+        .collect())
 }
 
 /// The frequency-domain method as a [`StabilitySolver`]: mu = e^{lambda tau} of the dominant pole.
