@@ -25,7 +25,10 @@ use serde::{Deserialize, Serialize};
 pub struct NoiseModel {
     /// Width w of the probit in ln(b / b_lim): label noise near the boundary.
     pub label_width_log_depth: f64,
-    /// Probability of an outright mislabel anywhere.
+    /// Probability that an observation is an outlier: an outright mislabel anywhere, or a
+    /// chatter frequency or pole that belongs to something else (a nonlinear limit cycle that
+    /// settled on another root, a spurious identified pole); such an observation is uniform
+    /// over its range (see [`terms`]).
     pub lapse: f64,
     /// Standard deviation of chatter frequencies as a fraction of the dominant natural frequency.
     pub chatter_std_fraction: f64,
@@ -232,6 +235,12 @@ pub(crate) fn chatter_residual(f: f64, predicted: f64, fold: Option<f64>) -> f64
     }
 }
 
+/// ln[(1 - lapse) p + lapse u] from ln p and ln u: an observation that is an outlier with
+/// probability `lapse` and then uniform over its range.
+fn with_lapse(ln_p: f64, ln_uniform: f64, lapse: f64) -> f64 {
+    log_sum_exp(&[(1.0 - lapse).ln() + ln_p, lapse.ln() + ln_uniform])
+}
+
 /// ln 1/2: a label the model cannot predict (solver failure).
 const LN_HALF: f64 = -std::f64::consts::LN_2;
 
@@ -252,29 +261,40 @@ pub(crate) fn terms(prediction: &Prediction, data: &Dataset, noise: &NoiseModel)
             None => LN_HALF,
         });
         let fold = prediction.cut_fold_hz[i];
-        chatter.push(c.chatter_hz.map(|f| match predicted {
-            Some(q) => ln_chatter_density(f, q.chatter_hz, data.chatter_std_hz, fold),
-            None => -fold.unwrap_or(2.0 * f.max(1.0)).ln(),
+        chatter.push(c.chatter_hz.map(|f| {
+            let uniform = -fold.unwrap_or(2.0 * f.max(1.0)).ln();
+            match predicted {
+                Some(q) => with_lapse(
+                    ln_chatter_density(f, q.chatter_hz, data.chatter_std_hz, fold),
+                    uniform,
+                    noise.lapse,
+                ),
+                None => uniform,
+            }
         }));
     }
     let pole = data
         .poles
         .iter()
         .enumerate()
-        .map(|(i, p)| match prediction.poles[i] {
-            Some(q) => {
-                let z = ln_normal(p.damping_ratio - q.damping_ratio, p.damping_std);
-                let ln: Vec<f64> = pole_frequency_images(
-                    p.frequency_hz,
-                    q.frequency_hz,
-                    prediction.pole_fold_hz[i],
-                )
-                .into_iter()
-                .map(|r| z + ln_normal(r, p.frequency_std_hz))
-                .collect();
-                log_sum_exp(&ln)
+        .map(|(i, p)| {
+            // frequency uniform over [0, 2 f], damping over a unit interval
+            let uniform = -(2.0 * p.frequency_hz.max(1.0)).ln();
+            match prediction.poles[i] {
+                Some(q) => {
+                    let z = ln_normal(p.damping_ratio - q.damping_ratio, p.damping_std);
+                    let ln: Vec<f64> = pole_frequency_images(
+                        p.frequency_hz,
+                        q.frequency_hz,
+                        prediction.pole_fold_hz[i],
+                    )
+                    .into_iter()
+                    .map(|r| z + ln_normal(r, p.frequency_std_hz))
+                    .collect();
+                    with_lapse(log_sum_exp(&ln), uniform, noise.lapse)
+                }
+                None => uniform,
             }
-            None => -(2.0 * p.frequency_hz.max(1.0)).ln(),
         })
         .collect();
     Terms {

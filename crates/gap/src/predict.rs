@@ -20,9 +20,9 @@
 //!   k / tau +- f_mu for milling, the eigenfunction's frequency for turning.
 //! - an identified **pole** at a stable cut: for milling lambda = ln(mu) / tau of the dominant
 //!   multiplier, lifted over the tooth period (principal frequency |Im lambda| / 2 pi, damping
-//!   -Re lambda / |lambda|, as in 002); for turning the physical root (000 Eq. 6) near the mode
-//!   whose root lies closest in frequency to the identified one (mode pairing: an
-//!   identification of a two-mode lathe may report either mode's pole).
+//!   -Re lambda / |lambda|, as in 002); for turning the physical root (000 Eq. 6): the dominant
+//!   root or a mode's own continued pole, whichever lies closest in frequency to the identified
+//!   one (mode pairing: an identification of a two-mode lathe may report either mode's pole).
 //!
 //! # Accuracy
 //! Against the semi-discretization at four times the resolution (the proving ground's truth)
@@ -37,7 +37,7 @@ use crate::data::Dataset;
 use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
-use chatter_stability::frequency_domain::{FrequencyDomain, mode_poles};
+use chatter_stability::frequency_domain::{FrequencyDomain, dominant_pole, mode_poles};
 use chatter_stability::monodromy::Discretization;
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -144,9 +144,9 @@ pub(crate) fn predict_cut(
 
 /// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).
 /// For milling it is the dominant multiplier's. For turning, where an identification of a
-/// multi-mode machine may lock onto a mode other than the least-damped one, it is the rightmost
-/// root near the mode closest in frequency to the identified `observed_hz` (mode pairing, as
-/// in modal updating); with one mode, or one mode dominating, that is the dominant root.
+/// multi-mode machine may lock onto a mode's own pole rather than the least-damped root, it is
+/// the one of {dominant root, each mode's continued pole} closest in frequency to the identified
+/// `observed_hz` (mode pairing, as in modal updating).
 pub(crate) fn predict_pole(
     variant: &Variant,
     speed_rpm: f64,
@@ -166,10 +166,12 @@ pub(crate) fn predict_pole(
         );
         observed_pole(lambda, true)
     } else {
+        let dominant = dominant_pole(&model, speed_rpm, depth_m).ok()?;
         mode_poles(&model, speed_rpm, depth_m)
             .ok()?
             .into_iter()
             .flatten()
+            .chain(std::iter::once(dominant))
             .map(|p| observed_pole(p.lambda, false))
             .min_by(|a, b| {
                 (a.frequency_hz - observed_hz)

@@ -206,19 +206,28 @@ pub fn closed_loop_poles(
 /// 4000 steps (tests here) and against the semi-discretization at 4x resolution on the gap
 /// proving ground's turning machine (|mu| within 4e-4 from 0.3x to 2x the limiting depth).
 pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<ClosedLoopPole> {
-    mode_poles(model, speed_rpm, width_m)?
-        .into_iter()
-        .flatten()
-        .max_by(|a, b| a.lambda.re.total_cmp(&b.lambda.re))
+    check_condition(speed_rpm, width_m)?;
+    let ch = Characteristic::new(model, speed_rpm)?;
+    let spacing = 2.0 * PI / ch.tau / 4.0;
+    ch.omegas
+        .iter()
+        .flat_map(|&w| {
+            let k = (0.15 * w / spacing).ceil() as i64;
+            (-k..=k).map(move |j| Complex64::new(0.0, w + j as f64 * spacing))
+        })
+        .filter_map(|start| ch.newton(start, width_m, GRID_NEWTON_ITERATIONS))
+        .filter(|root| root.im > 0.0)
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(ClosedLoopPole::new)
         .ok_or(StabilityError::NoConvergence {
             solver: "characteristic-equation Newton",
             detail: format!("no root found at {speed_rpm} rpm, width {width_m} m"),
         })
 }
 
-/// For every mode, the rightmost closed-loop root found from that mode's grid of starts (see
-/// [`dominant_pole`]; `None` where no start converged): the pole an identification sees near
-/// each mode. Their maximum by real part is the dominant pole.
+/// Each mode's own closed-loop pole, continued in the width from its structural pole as
+/// [`closed_loop_poles`] does, `None` where the continuation fails: the pole an identification
+/// sees near that mode, which need not be the dominant one.
 pub fn mode_poles(
     model: &ModalModel,
     speed_rpm: f64,
@@ -226,19 +235,14 @@ pub fn mode_poles(
 ) -> Result<Vec<Option<ClosedLoopPole>>> {
     check_condition(speed_rpm, width_m)?;
     let ch = Characteristic::new(model, speed_rpm)?;
-    let spacing = 2.0 * PI / ch.tau / 4.0;
-    Ok(ch
-        .omegas
+    Ok(model
+        .modes()
         .iter()
-        .map(|&w| {
-            let k = (0.15 * w / spacing).ceil() as i64;
-            (-k..=k)
-                .filter_map(|j| {
-                    let start = Complex64::new(0.0, w + j as f64 * spacing);
-                    ch.newton(start, width_m, GRID_NEWTON_ITERATIONS)
-                })
-                .filter(|root| root.im > 0.0)
-                .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(|m| {
+            let (w, z) = (m.omega_rad_s(), m.damping_ratio());
+            let start = Complex64::new(-z * w, w * (1.0 - z * z).sqrt());
+            ch.continue_pole(start, width_m)
+                .ok()
                 .map(ClosedLoopPole::new)
         })
         .collect())
