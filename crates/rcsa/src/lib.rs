@@ -7,7 +7,9 @@
 //!   truncation);
 //! - [`coupling`]: the holder-tool connection K(k, c, omega) (Eq. 4), coupling (Eq. 3) and
 //!   decoupling of a spindle from an artifact tap test (Eq. 1);
-//! - [`assembly`]: the assembly file and the tool-tip FRF.
+//! - [`assembly`]: the assembly file and the tool-tip FRF;
+//! - [`prior`]: 004's prior: FRF ensemble over the connection, two-mode fits, multivariate
+//!   normal prior, probability-of-stability map.
 //!
 //! ```
 //! use chatter_rcsa::{Assembly, Connection, Segment, Spindle};
@@ -33,6 +35,7 @@ pub mod assembly;
 pub mod beam;
 pub mod coupling;
 pub mod error;
+pub mod prior;
 
 pub use assembly::{Assembly, AssemblyFile, SampledReceptance, Spindle, frequency_band};
 pub use beam::{EndReceptances, Receptance, Segment, free_free_receptances};
