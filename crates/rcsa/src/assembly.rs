@@ -188,7 +188,10 @@ impl SampledReceptance {
                 format!("at least 2, one per frequency ({})", frequencies_hz.len()),
             ));
         }
-        if let Some(w) = frequencies_hz.windows(2).find(|w| !(w[1] > w[0])) {
+        if let Some(w) = frequencies_hz
+            .windows(2)
+            .find(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
             return Err(RcsaError::value(
                 "frequency_hz",
                 w[1],

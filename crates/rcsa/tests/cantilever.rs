@@ -2,6 +2,7 @@
 //! receptance, no holder): the RCSA tip FRF against closed-form cantilever frequencies, and the
 //! free-free receptances of a stepped hollow beam against an independent Euler-Bernoulli finite
 //! element model written here.
+#![allow(clippy::unwrap_used)]
 
 use chatter_rcsa::{Assembly, Connection, Segment, Spindle, free_free_receptances};
 use nalgebra::{DMatrix, DVector};

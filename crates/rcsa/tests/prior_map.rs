@@ -2,6 +2,7 @@
 //! theory says (a stiffer joint raises the first mode), the prior is a valid covariance, the
 //! probability-of-stability map is monotone in depth and its 0.5 contour lies near the boundary
 //! of the mean parameters.
+#![allow(clippy::unwrap_used)]
 
 use chatter_rcsa::Assembly;
 use chatter_rcsa::prior::{
