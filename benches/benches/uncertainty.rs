@@ -6,6 +6,7 @@ use chatter_stability::boundary::{BoundaryOptions, speed_range};
 use chatter_stability::monodromy::Discretization;
 use chatter_uncertainty::montecarlo::{gaussian_draws, sample_boundaries};
 use chatter_uncertainty::perturbation::model_moment_grid;
+use chatter_updating::parameters::{ModelParameter, Parameterization};
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::DMatrix;
 
@@ -27,12 +28,17 @@ fn bench(c: &mut Criterion) {
     });
     let thetas = gaussian_draws(&[0.0; 3], &sigma, 1000, 1).unwrap_or_default();
     let mc_speeds = speed_range(5000.0, 25_000.0, 50).unwrap_or_default();
+    let Ok(parameterization) = Parameterization::new(
+        model.clone(),
+        params.iter().map(|&p| ModelParameter::Modal(p)).collect(),
+    ) else {
+        return;
+    };
     group.bench_function("montecarlo_map_1000_samples_50_speeds_sdof_fdm_m40", |b| {
         b.iter(|| {
             sample_boundaries(
                 &fdm40,
-                &model,
-                &params,
+                &parameterization,
                 &thetas,
                 &mc_speeds,
                 &BoundaryOptions::default(),

@@ -227,7 +227,7 @@ pub fn credibility_bands(
     let grid = model_moment_grid(
         method,
         mean_model,
-        &dist.parameters,
+        &dist.modal_parameters()?,
         &dist.covariance_about_mean(),
         speeds,
         depths,
@@ -278,8 +278,7 @@ fn montecarlo(
     let bar = Bar::new(thetas.len() as u64, "Monte Carlo samples", req.quiet);
     let sampled = sample_boundaries(
         &method,
-        model,
-        &dist.parameters,
+        &dist.parameterization(model)?,
         &thetas,
         speeds,
         &BoundaryOptions::default(),

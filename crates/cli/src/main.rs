@@ -12,6 +12,7 @@ mod output;
 mod plan;
 mod plot;
 mod progress;
+mod rcsa;
 mod update;
 
 use bands::BandKind;
@@ -247,6 +248,8 @@ enum Command {
     /// Modal fit of a measured FRF (LSCF, stabilization, residual terms): model file, JSON
     /// report on stdout, overlay plot.
     FitFrf(measured::FitFrfArgs),
+    /// Tool-tip FRF of a tool-holder-spindle assembly by receptance coupling (RCSA).
+    Rcsa(rcsa::RcsaArgs),
     /// Run the main job on the embedded examples and write the results to a folder.
     Demo {
         /// Output folder.
@@ -416,6 +419,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plot.as_deref(),
         ),
         Command::FitFrf(args) => measured::fit_frf(&args),
+        Command::Rcsa(args) => rcsa::rcsa(&args),
         Command::Demo { out } => commands::demo(&out, quiet),
     }
 }

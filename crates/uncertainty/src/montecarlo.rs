@@ -15,9 +15,9 @@
 //! does not stop the map.
 
 use crate::error::{Result, UncertaintyError};
-use chatter_dynamics::{ModalModel, Parameter};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
+use chatter_updating::parameters::Parameterization;
 use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -249,17 +249,17 @@ pub fn gaussian_draws(
         .collect())
 }
 
-/// The boundary of `model` perturbed by each parameter sample `thetas[s]` (see
-/// [`chatter_dynamics::ModalModel::perturbed`]) at every speed, in parallel over samples; the
-/// result does not depend on the thread count. `progress(done, total)` is called per sample.
+/// The boundary of the model of each parameter sample `thetas[s]` (see
+/// [`Parameterization::model`]: modal perturbations and the absolute cutting coefficients and
+/// process damping, all sampled) at every speed, in parallel over samples; the result does not
+/// depend on the thread count. `progress(done, total)` is called per sample.
 ///
 /// A sample that gives no valid model, or whose boundary search fails at a speed, is recorded in
 /// [`SampledBoundaries::failures`] with a NaN limit and the map goes on; only invalid options
 /// (which would fail every sample alike) are an error.
 pub fn sample_boundaries<S: StabilitySolver + ?Sized>(
     solver: &S,
-    model: &ModalModel,
-    parameters: &[Parameter],
+    parameterization: &Parameterization,
     thetas: &[Vec<f64>],
     speeds_rpm: &[f64],
     options: &BoundaryOptions,
@@ -282,7 +282,7 @@ pub fn sample_boundaries<S: StabilitySolver + ?Sized>(
         .par_iter()
         .enumerate()
         .map(|(k, theta)| {
-            let row = match model.perturbed(parameters, theta) {
+            let row = match parameterization.model(theta) {
                 Err(e) => (
                     vec![(f64::NAN, f64::NAN); speeds_rpm.len()],
                     vec![failed(k, None, FailureKind::InvalidSample, e.to_string())],
@@ -356,8 +356,9 @@ mod tests {
     /// samples that succeeded (exactly 1 below 1 mm and 0 above, never inflated by failures).
     #[test]
     fn failures_are_counted_not_read_as_stable() {
-        use chatter_dynamics::{Parameter, examples};
+        use chatter_dynamics::{ModalModel, Parameter, examples};
         use chatter_stability::{DominantMultiplier, StabilityError};
+        use chatter_updating::parameters::ModelParameter;
         use num_complex::Complex64;
         struct Flaky(f64);
         impl StabilitySolver for Flaky {
@@ -393,6 +394,8 @@ mod tests {
         let model = examples::insperger_benchmark(1.0);
         let solver = Flaky(model.modes()[0].frequency_hz());
         let params: Vec<Parameter> = vec!["theta_omega_1".parse().unwrap()];
+        let params =
+            Parameterization::new(model.clone(), vec![ModelParameter::Modal(params[0])]).unwrap();
         // 10 samples: 6 nominal, 2 raised by 10 %, 2 lowered by 10 %
         let thetas: Vec<Vec<f64>> = [0.0, 0.0, 0.1, 0.0, -0.1, 0.0, 0.1, 0.0, -0.1, 0.0]
             .iter()
@@ -401,7 +404,6 @@ mod tests {
         let speeds = [1000.0, 2000.0];
         let sampled = sample_boundaries(
             &solver,
-            &model,
             &params,
             &thetas,
             &speeds,

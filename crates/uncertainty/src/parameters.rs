@@ -8,20 +8,26 @@
 //!   `posterior_covariance`, and optionally `posterior.csv` whose header names the parameters and
 //!   whose rows are samples.
 //!
-//! Names that are not model parameters (the error variance `sigma_r2`, say) are dropped with their
-//! rows and columns.
+//! The names are those of `chatter update` (`chatter_updating::parameters::ModelParameter`):
+//! relative modal perturbations `theta_omega_N`, ... and the absolute process parameters
+//! `kt_n_per_mm2`, `kn_n_per_mm2` (cutting-force coefficients) and `c_n_per_m`. Every one of them
+//! is sampled by the Monte Carlo maps. The error variances of a posterior (names starting with
+//! `sigma_`) are not model parameters and are dropped with their rows and columns; any other
+//! name is an error, never silently left out. The absolute parameters need a `mean`.
 
 use crate::error::{Result, UncertaintyError};
 use crate::montecarlo::gaussian_draws;
 use chatter_dynamics::{ModalModel, Parameter};
+use chatter_updating::parameters::{ModelParameter, Parameterization};
 use nalgebra::DMatrix;
 use std::path::Path;
 
-/// A distribution of named perturbation parameters theta (000 Eq. 12-13: omega(1 + theta) etc.).
+/// A distribution of named model parameters: relative perturbations theta (000 Eq. 12-13:
+/// omega(1 + theta) etc.) and absolute process parameters (cutting coefficients in N/mm^2).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParameterDistribution {
     /// The parameters.
-    pub parameters: Vec<Parameter>,
+    pub parameters: Vec<ModelParameter>,
     /// Mean of theta.
     pub mean: Vec<f64>,
     /// Covariance of theta.
@@ -54,7 +60,7 @@ struct SummaryFile {
 }
 
 impl ParameterDistribution {
-    /// Validate shapes and keep only the model parameters among `names`.
+    /// Validate shapes and keep the model parameters among `names` (dropping only `sigma_*`).
     pub fn new(
         names: &[String],
         mean: Vec<f64>,
@@ -84,18 +90,30 @@ impl ParameterDistribution {
                 format!("a sample has {} values, expected {d}", bad.len()),
             ));
         }
-        let keep: Vec<(usize, Parameter)> = names
-            .iter()
-            .enumerate()
-            .filter_map(|(i, n)| n.parse::<Parameter>().ok().map(|p| (i, p)))
-            .collect();
+        let mut keep: Vec<(usize, ModelParameter)> = Vec::new();
+        for (i, n) in names.iter().enumerate() {
+            if n.starts_with("sigma_") {
+                continue;
+            }
+            let p = n.parse::<ModelParameter>().map_err(|_| {
+                invalid(
+                    source,
+                    format!(
+                        "`{n}` is not a parameter that can be sampled (theta_omega_N, \
+                         theta_zeta_N, theta_phi_N, theta_k_N, kt_n_per_mm2, kn_n_per_mm2, \
+                         c_n_per_m; sigma_* error variances are dropped)"
+                    ),
+                )
+            })?;
+            if keep.iter().any(|k| k.1 == p) {
+                return Err(invalid(source, format!("`{n}` is listed twice")));
+            }
+            keep.push((i, p));
+        }
         if keep.is_empty() {
             return Err(invalid(
                 source,
-                format!(
-                    "none of the names {names:?} is a model parameter (theta_omega_N, \
-                     theta_zeta_N, theta_phi_N or theta_k_N)"
-                ),
+                format!("none of the names {names:?} is a model parameter"),
             ));
         }
         let idx: Vec<usize> = keep.iter().map(|k| k.0).collect();
@@ -123,7 +141,25 @@ impl ParameterDistribution {
         let text = read(path)?;
         let f: CovarianceFile =
             serde_json::from_str(&text).map_err(|e| invalid(path, e.to_string()))?;
-        let mean = f.mean.unwrap_or_else(|| vec![0.0; f.parameter_names.len()]);
+        let mean = match f.mean {
+            Some(m) => m,
+            None => {
+                if let Some(n) = f.parameter_names.iter().find(|n| {
+                    matches!(
+                        n.parse::<ModelParameter>(),
+                        Ok(p) if !matches!(p, ModelParameter::Modal(_))
+                    )
+                }) {
+                    return Err(invalid(
+                        path,
+                        format!(
+                            "`{n}` is an absolute value: give `mean` (it defaults to zero only for theta parameters)"
+                        ),
+                    ));
+                }
+                vec![0.0; f.parameter_names.len()]
+            }
+        };
         Self::new(&f.parameter_names, mean, f.covariance, None, path)
     }
 
@@ -148,24 +184,60 @@ impl ParameterDistribution {
         )
     }
 
+    /// The map from parameter values to models around `nominal`.
+    pub fn parameterization(&self, nominal: &ModalModel) -> Result<Parameterization> {
+        Parameterization::new(nominal.clone(), self.parameters.clone()).map_err(|e| {
+            UncertaintyError::InvalidInput {
+                field: "parameters",
+                message: e.to_string(),
+            }
+        })
+    }
+
     /// The model at the mean parameters.
     pub fn mean_model(&self, nominal: &ModalModel) -> Result<ModalModel> {
-        nominal
-            .perturbed(&self.parameters, &self.mean)
+        self.parameterization(nominal)?
+            .model(&self.mean)
             .map_err(|e| UncertaintyError::InvalidInput {
                 field: "mean",
                 message: e.to_string(),
             })
     }
 
-    /// The covariance of theta' measured from the mean model instead of the nominal one. Every
+    /// The modal parameters, for the methods that propagate only those (the second-order
+    /// perturbation of 000 Eq. 14-18): an error naming the first process parameter otherwise,
+    /// so that its variance is never dropped.
+    pub fn modal_parameters(&self) -> Result<Vec<Parameter>> {
+        self.parameters
+            .iter()
+            .map(|p| match p {
+                ModelParameter::Modal(m) => Ok(*m),
+                other => Err(UncertaintyError::InvalidInput {
+                    field: "parameters",
+                    message: format!(
+                        "`{other}` cannot be propagated by the perturbation bounds (modal \
+                         parameters only); use the Monte Carlo map, which samples it"
+                    ),
+                }),
+            })
+            .collect()
+    }
+
+    /// The covariance of theta' measured from the mean model instead of the nominal one. A modal
     /// parameter scales a nominal value by (1 + theta), so x_0 (1 + theta) = x_0 (1 + mean)
-    /// (1 + theta') gives theta' = (theta - mean) / (1 + mean): Sigma' = D Sigma D with
-    /// D = diag(1 / (1 + mean_i)).
+    /// (1 + theta') gives theta' = (theta - mean) / (1 + mean); an absolute parameter is only
+    /// shifted (theta' = theta - mean). Sigma' = D Sigma D with D = diag(1 / (1 + mean_i)) for
+    /// the modal and 1 for the absolute parameters.
     pub fn covariance_about_mean(&self) -> DMatrix<f64> {
         let d = DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(
             self.mean.len(),
-            self.mean.iter().map(|m| 1.0 / (1.0 + m)),
+            self.parameters
+                .iter()
+                .zip(&self.mean)
+                .map(|(p, m)| match p {
+                    ModelParameter::Modal(_) => 1.0 / (1.0 + m),
+                    _ => 1.0,
+                }),
         ));
         &d * &self.covariance * &d
     }
@@ -228,6 +300,51 @@ fn read_samples(path: &Path, names: &[String]) -> Result<Vec<Vec<f64>>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unknown_names_are_errors_and_cutting_coefficients_are_kept() {
+        let names = vec!["kt_n_per_mm2".to_string(), "theta_omega_1".into()];
+        let d = ParameterDistribution::new(
+            &names,
+            vec![700.0, 0.0],
+            vec![vec![4900.0, 0.0], vec![0.0, 1e-6]],
+            None,
+            Path::new("x.json"),
+        )
+        .unwrap();
+        assert_eq!(d.parameters[0], ModelParameter::KtNPerMm2);
+        assert!(
+            d.modal_parameters()
+                .unwrap_err()
+                .to_string()
+                .contains("kt_n_per_mm2")
+        );
+        // absolute parameters are shifted, not scaled
+        assert_eq!(d.covariance_about_mean()[(0, 0)], 4900.0);
+        let e = ParameterDistribution::new(
+            &["kt".to_string()],
+            vec![700.0],
+            vec![vec![4900.0]],
+            None,
+            Path::new("x.json"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("`kt`") && e.contains("kt_n_per_mm2"), "{e}");
+        let dir = std::env::temp_dir().join(format!("chatter-unc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("kt.json");
+        std::fs::write(
+            &file,
+            r#"{"parameter_names": ["kt_n_per_mm2"], "covariance": [[4900]]}"#,
+        )
+        .unwrap();
+        let e = ParameterDistribution::from_covariance_file(&file)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("give `mean`"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn drops_non_model_parameters_and_checks_shapes() {

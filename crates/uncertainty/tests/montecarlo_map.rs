@@ -6,6 +6,7 @@ use chatter_dynamics::{Parameter, examples};
 use chatter_stability::boundary::{BoundaryOptions, lobe_diagram};
 use chatter_stability::frequency_domain::FrequencyDomain;
 use chatter_uncertainty::montecarlo::{gaussian_draws, sample_boundaries};
+use chatter_updating::parameters::{ModelParameter, Parameterization};
 use nalgebra::DMatrix;
 
 #[test]
@@ -21,10 +22,14 @@ fn map_of_the_turning_case_is_monotone_and_centred_on_the_mean_boundary() {
     let speeds: Vec<f64> = (0..4).map(|i| 6900.0 + 200.0 * i as f64).collect();
     let options = BoundaryOptions::default();
     let solver = FrequencyDomain;
+    let parameterization = Parameterization::new(
+        model.clone(),
+        params.iter().map(|&p| ModelParameter::Modal(p)).collect(),
+    )
+    .unwrap();
     let sampled = sample_boundaries(
         &solver,
-        &model,
-        &params,
+        &parameterization,
         &thetas,
         &speeds,
         &options,

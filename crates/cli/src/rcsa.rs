@@ -1,0 +1,55 @@
+//! `chatter rcsa`: the tool-tip FRF of a tool-holder-spindle assembly by receptance coupling
+//! (Schmitz et al. 2022, Eq. 1-4; crate `chatter-rcsa`).
+
+use crate::output::emit;
+use crate::plot::{Series, line_chart};
+use anyhow::{Context, Result};
+use chatter_frf::text::to_csv;
+use chatter_rcsa::Assembly;
+use plotters::style::BLUE;
+use std::path::PathBuf;
+
+/// Arguments of `chatter rcsa`.
+#[derive(Debug, clap::Args)]
+pub struct RcsaArgs {
+    /// Assembly file (JSON: tool, holder, connection, spindle, band; see the README).
+    #[arg(long)]
+    assembly: PathBuf,
+    /// Output CSV (`chatter frf` columns); stdout when absent.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// SVG plot of |h| at the tool tip.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// `chatter rcsa`: predict, write the CSV, plot.
+pub fn rcsa(args: &RcsaArgs) -> Result<()> {
+    let assembly = Assembly::from_path(&args.assembly).context("reading the assembly")?;
+    let tip = assembly
+        .tool_tip_frf()
+        .with_context(|| format!("coupling {}", args.assembly.display()))?;
+    emit(args.out.as_deref(), &to_csv(&tip))?;
+    if let Some(p) = &args.plot {
+        let series = [Series {
+            label: "tool tip |h| (RCSA)".into(),
+            points: tip
+                .frequencies_hz()
+                .iter()
+                .zip(tip.receptance_m_per_n())
+                .map(|(f, g)| (*f, g.norm() * 1e6))
+                .collect(),
+            color: BLUE,
+            dashed: false,
+        }];
+        line_chart(
+            p,
+            &format!("RCSA tool-tip FRF of {}", args.assembly.display()),
+            "frequency (Hz)",
+            "|h| (um/N)",
+            &series,
+            None,
+        )?;
+    }
+    Ok(())
+}
