@@ -6,8 +6,10 @@
 //! effect). Every true quantity comes from the **semi-discretization** (Insperger and Stépán)
 //! at four times the automatic resolution of the true model (at least 160 steps per delay),
 //! while the diagnosis uses the first-order **full discretization** at the automatic
-//! resolution: another scheme at a converged resolution, so the inference's discretization
-//! error shows in the data as it would against a real machine. `tests/proving_ground.rs`
+//! resolution (turning: the characteristic roots): another scheme at a converged resolution,
+//! so the inference's approximation error shows in the data as it would against a real
+//! machine. Where the truth's eigen-solver stalls, the truth is recomputed on a finer grid and
+//! then with the full discretization at four times the resolution. `tests/proving_ground.rs`
 //! checks the truth against an independent computation written in the test.
 //!
 //! # Campaign
@@ -365,22 +367,27 @@ fn truth_solver_refined(
 }
 
 /// `f` with the truth's solver; when its eigen-solver fails (Arnoldi can stall on clustered
-/// multipliers of a large operator), once more at five times the automatic resolution, an
-/// equally converged grid with another operator.
+/// multipliers of a large operator, seen on turning with process damping at long delays), once
+/// more at five times the automatic resolution, then with the first-order full discretization
+/// at four times: equally converged grids with other operators.
 fn with_truth<T>(
     model: &ModalModel,
     speed_rpm: f64,
     f: impl Fn(&Discretization) -> chatter_stability::Result<T>,
 ) -> Result<T> {
-    match f(&truth_solver(model, speed_rpm)?) {
-        Ok(v) => Ok(v),
-        Err(first) => f(&truth_solver_refined(
-            model,
-            speed_rpm,
-            TRUTH_REFINEMENT + 1,
-        )?)
-        .map_err(|e| GapError::Model(format!("{first}; at a finer grid: {e}"))),
+    let first = match f(&truth_solver(model, speed_rpm)?) {
+        Ok(v) => return Ok(v),
+        Err(e) => e,
+    };
+    if let Ok(v) = f(&truth_solver_refined(model, speed_rpm, TRUTH_REFINEMENT + 1)?) {
+        return Ok(v);
     }
+    let semi = truth_solver(model, speed_rpm)?;
+    let full = Discretization::full().with_steps(match semi.steps {
+        StepsPerDelay::Fixed(m) => m,
+        StepsPerDelay::Auto => TRUTH_MIN_STEPS,
+    });
+    f(&full).map_err(|e| GapError::Model(format!("{first}; on finer and other grids: {e}")))
 }
 
 /// The true limiting depth (m) of `model` at a speed; infinite where no lobe is below 1 m.
