@@ -161,12 +161,7 @@ pub fn limiting_depth_near<S: StabilitySolver + ?Sized>(
             None => return Ok(unbounded),
         },
     };
-    let bracket = illinois(
-        bracket,
-        options.relative_tolerance,
-        MAX_REFINEMENT_STEPS,
-        f,
-    )?;
+    let bracket = illinois(bracket, options.relative_tolerance, MAX_REFINEMENT_STEPS, f)?;
     let depth_m = bracket.root();
     let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
     Ok(LobePoint {

@@ -941,7 +941,9 @@ fn arnoldi<F: Fn(&[f64], &mut [f64])>(
 ) -> Result<(Complex64, Vec<Complex64>)> {
     let k = config.dim.min(d - 1);
     let mut start: Vec<f64> = match initial {
-        Some(v) if v.iter().any(|x| *x != 0.0 && x.is_finite()) && v.iter().all(|x| x.is_finite()) => {
+        Some(v)
+            if v.iter().any(|x| *x != 0.0 && x.is_finite()) && v.iter().all(|x| x.is_finite()) =>
+        {
             v.to_vec()
         }
         // deterministic start vector

@@ -82,10 +82,7 @@ impl Method {
         options: &BoundaryOptions,
     ) -> Result<Box<dyn PreparedSolver>> {
         Ok(match self.discretization() {
-            None => Box::new(PreparedZeroOrder::new(
-                model,
-                &zero_order_options(options),
-            )?),
+            None => Box::new(PreparedZeroOrder::new(model, &zero_order_options(options))?),
             Some(d) => Box::new(PreparedDiscretization::new(d, model, options)?),
         })
     }
@@ -116,11 +113,7 @@ pub trait PreparedSolver: Send + Sync {
     fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint>;
 
     /// Limiting depths at `speeds_rpm`, in parallel; `observer` hears of each speed done.
-    fn lobes(
-        &self,
-        speeds_rpm: &[f64],
-        observer: &dyn BoundaryObserver,
-    ) -> Result<Vec<LobePoint>> {
+    fn lobes(&self, speeds_rpm: &[f64], observer: &dyn BoundaryObserver) -> Result<Vec<LobePoint>> {
         let done = std::sync::atomic::AtomicUsize::new(0);
         speeds_rpm
             .par_iter()
@@ -393,8 +386,8 @@ mod tests {
         let flexure = examples::process_damping_flexure(Some(2.5e5));
         let mill = examples::schmitz_2023_milling();
         for (model, speed) in [(&flexure, 300.0), (&flexure, 2000.0), (&mill, 6960.0)] {
-            let prepared = PreparedDiscretization::new(Discretization::full(), model, &options)
-                .unwrap();
+            let prepared =
+                PreparedDiscretization::new(Discretization::full(), model, &options).unwrap();
             let guided = PreparedSolver::limiting_depth(&prepared, speed).unwrap();
             let scanned = limiting_depth(&Discretization::full(), model, speed, &options).unwrap();
             assert!(

@@ -119,12 +119,12 @@ impl PreparedZeroOrder {
         let table = LobeTable::new(OrientedSystem::from_model(model)?);
         // the slopes at unit C / V, scaled by C / V at each speed
         let per_cv = damping_ratio_slopes_per_cv(model);
-        let tables =
-            if model.process_damping_n_per_m().is_some() && per_cv.iter().any(|s| *s > 0.0) {
-                Tables::Damped(ProcessDampedTable::owning(table, &per_cv, options)?)
-            } else {
-                Tables::Bare(table)
-            };
+        let tables = if model.process_damping_n_per_m().is_some() && per_cv.iter().any(|s| *s > 0.0)
+        {
+            Tables::Damped(ProcessDampedTable::owning(table, &per_cv, options)?)
+        } else {
+            Tables::Bare(table)
+        };
         Ok(Self {
             model: model.clone(),
             tables,
@@ -143,7 +143,9 @@ impl PreparedZeroOrder {
         check_condition(speed_rpm, 0.0)?;
         let tau = self.model.operation().delay_s(speed_rpm);
         let lobes = match &self.tables {
-            Tables::Damped(d) => d.lobes(tau, self.model.process_damping_per_width(speed_rpm), 1)?,
+            Tables::Damped(d) => {
+                d.lobes(tau, self.model.process_damping_per_width(speed_rpm), 1)?
+            }
             Tables::Bare(t) => t.lobes(tau, 1)?,
         };
         Ok(match lobes.first() {
