@@ -7,7 +7,6 @@ use anyhow::{Context, Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
-use chatter_stability::monodromy::Discretization;
 pub use chatter_stability::prepared::Method;
 use chatter_stability::zero_order::{ZeroOrderOptions, limiting_depths, zoa_lobes};
 use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
