@@ -1,11 +1,13 @@
 //! Stability solver speed: the dominant multiplier of the single-DOF benchmark at m = 40, a
 //! 200-speed FDM lobe diagram at m = 40, the seed-000 turning multiplier at the default
 //! resolution, and the zero-order limiting depth at one speed (seed-001 two-mode milling, seed-000
-//! turning) and over a 200-speed lobe diagram.
+//! turning) and over a 200-speed lobe diagram; the same FDM lobe diagram by the prepared solver
+//! (boundary search from the zero-order limit, warm-started Arnoldi).
 use chatter_dynamics::examples;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, Silent, lobe_diagram, speed_range};
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::prepared::{PreparedDiscretization, PreparedSolver};
 use chatter_stability::zero_order::{zoa_limiting_depth, zoa_lobes};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -37,6 +39,10 @@ fn bench(c: &mut Criterion) {
                 &Silent,
             )
         })
+    });
+    let prepared = PreparedDiscretization::new(fdm40, &benchmark, &BoundaryOptions::default()).ok();
+    group.bench_function("lobes_200_speeds_fdm_m40_prepared", |b| {
+        b.iter(|| prepared.as_ref().map(|p| p.lobes(&speeds, &Silent)))
     });
     group.finish();
 }

@@ -1,7 +1,7 @@
 //! `chatter bands`: geometric Type B offsets, perturbation credibility bounds and Monte Carlo
 //! probability-of-stability maps around the lobes.
 
-use crate::commands::{Method, compute_lobes, default_speeds, markers};
+use crate::commands::{Method, compute_lobes, markers};
 use crate::output::{emit, write_atomic};
 use crate::plot::{Series, line_chart};
 use crate::{inputs, progress::Bar};
@@ -67,7 +67,7 @@ pub fn bands(req: &BandRequest) -> Result<()> {
     let obs = req.observations.map(inputs::observations).transpose()?;
     let speeds = match req.speeds {
         Some(s) => inputs::speeds(s)?,
-        None => default_speeds(&model),
+        None => chatter_stability::boundary::default_speeds_rpm(&model),
     };
     match req.kind {
         BandKind::Geometric => geometric(req, &model, &speeds, obs.as_ref()),
@@ -166,7 +166,7 @@ fn distribution(req: &BandRequest) -> Result<ParameterDistribution> {
 }
 
 fn discretization(req: &BandRequest) -> Result<chatter_stability::monodromy::Discretization> {
-    match req.method.unwrap_or(Method::Fdm).solver() {
+    match req.method.unwrap_or(Method::Fdm).discretization() {
         Some(d) => Ok(d),
         None => bail!("--kind {:?} needs --method fdm or sdm", req.kind),
     }

@@ -6,34 +6,13 @@ use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::StabilitySolver;
-use chatter_stability::boundary::{BoundaryOptions, LobePoint, lobe_diagram};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::boundary::{BoundaryOptions, LobePoint};
+pub use chatter_stability::prepared::Method;
 use chatter_stability::zero_order::{ZeroOrderOptions, limiting_depths, zoa_lobes};
 use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
 use plotters::style::BLUE;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// Stability method names of the CLI.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Zero-order approximation (Altintas-Budak; exact for turning).
-    Zoa,
-    /// First-order full discretization.
-    Fdm,
-    /// First-order semi-discretization.
-    Sdm,
-}
-
-impl Method {
-    pub fn solver(self) -> Option<Discretization> {
-        match self {
-            Method::Zoa => None,
-            Method::Fdm => Some(Discretization::full()),
-            Method::Sdm => Some(Discretization::semi()),
-        }
-    }
-}
 
 /// `chatter check`.
 pub fn check(model: &Path, observations: Option<&Path>) -> Result<()> {
@@ -135,17 +114,6 @@ fn frf_csv(model: &ModalModel, f0: f64, f1: f64, points: usize, i: usize, j: usi
     csv
 }
 
-/// Default speed range: around the lobes of the dominant mode (lobe numbers ~1 to 10).
-pub fn default_speeds(model: &ModalModel) -> Vec<f64> {
-    let f = chatter_stability::boundary::dominant_mode_frequency_hz(model);
-    let n = model.operation().delays_per_revolution() as f64;
-    let max = (60.0 * f / n * 1.2).min(60_000.0);
-    let min = max / 10.0;
-    (0..200)
-        .map(|i| min + (max - min) * i as f64 / 199.0)
-        .collect()
-}
-
 /// Limiting depths with the chosen method.
 pub fn compute_lobes(
     model: &ModalModel,
@@ -153,16 +121,18 @@ pub fn compute_lobes(
     speeds: &[f64],
     quiet: bool,
 ) -> Result<Vec<LobePoint>> {
-    match method.solver() {
-        // the model's process damping included (003), as the discretizations do
-        None => Ok(limiting_depths(
+    match method {
+        // the model's process damping included (003), as the discretizations do; no ceiling
+        Method::Zoa => Ok(limiting_depths(
             model,
             speeds,
             &ZeroOrderOptions::unbounded(),
         )?),
-        Some(solver) => {
+        Method::Fdm | Method::Sdm => {
             let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
-            let lobes = lobe_diagram(&solver, model, speeds, &BoundaryOptions::default(), &bar)?;
+            let lobes = method
+                .prepare(model, &BoundaryOptions::default())?
+                .lobes(speeds, &bar)?;
             bar.finish();
             Ok(lobes)
         }
@@ -209,7 +179,7 @@ fn load_and_compute(
     let model = inputs::model(model_path)?;
     let speeds = match speeds {
         Some(s) => inputs::speeds(s)?,
-        None => default_speeds(&model),
+        None => chatter_stability::boundary::default_speeds_rpm(&model),
     };
     Ok((obs, compute_lobes(&model, method, &speeds, quiet)?))
 }
@@ -248,7 +218,7 @@ pub fn lobes(
 /// `chatter multiplier`.
 pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Method) -> Result<()> {
     let model = inputs::model(model_path)?;
-    let Some(solver) = method.solver() else {
+    let Some(solver) = method.discretization() else {
         bail!("--method zoa gives limiting depths, not multipliers; use fdm or sdm");
     };
     let (mu, chatter_hz) = solver.chatter_frequency_hz(&model, speed_rpm, depth_mm * 1e-3)?;

@@ -35,6 +35,7 @@ pub mod model_file;
 pub mod observations;
 pub mod operation;
 pub mod perturbation;
+pub mod pole;
 mod resample;
 pub mod sampled;
 pub mod simulate;

@@ -108,17 +108,121 @@ pub fn dominant_mode_frequency_hz(model: &ModalModel) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// The limiting depth at one speed.
+/// The limiting depth at one speed: the first crossing of |mu| = 1 on a geometric scan from
+/// `options.start_depth_m`, refined by Illinois steps.
 pub fn limiting_depth<S: StabilitySolver + ?Sized>(
     solver: &S,
     model: &ModalModel,
     speed_rpm: f64,
     options: &BoundaryOptions,
 ) -> Result<LobePoint> {
+    limiting_depth_near(solver, model, speed_rpm, None, options)
+}
+
+/// The limiting depth at one speed, searched from a first guess `guess_m` (e.g. the zero-order
+/// limit, microseconds per speed): the bracket [b_g / g^k, b_g g^k] (g = `options.growth`) is
+/// widened from the guess until |mu| - 1 changes sign, then refined as in [`limiting_depth`].
+/// Near a good guess this takes a few evaluations instead of the ~30 of the scan from
+/// `options.start_depth_m`. Where the widening falls below the start depth, or without a (finite,
+/// positive) guess, it is the scan of [`limiting_depth`], which also checks that the structure is
+/// stable at zero depth. Like the scan, it assumes the cut is stable below the crossing it finds
+/// (no unstable island between the scan's points).
+pub fn limiting_depth_near<S: StabilitySolver + ?Sized>(
+    solver: &S,
+    model: &ModalModel,
+    speed_rpm: f64,
+    guess_m: Option<f64>,
+    options: &BoundaryOptions,
+) -> Result<LobePoint> {
     options.validate()?;
     let f = |b: f64| -> Result<f64> {
         Ok(solver.dominant_multiplier(model, speed_rpm, b)?.modulus() - 1.0)
     };
+    let unbounded = LobePoint {
+        speed_rpm,
+        depth_m: f64::INFINITY,
+        chatter_hz: f64::NAN,
+    };
+    let guess = guess_m
+        .filter(|b| b.is_finite() && *b >= options.start_depth_m)
+        .map(|b| b.min(options.max_depth_m));
+    let bracket = match guess {
+        Some(b) => match widen_from_guess(&f, b, options)? {
+            Widened::Bracket(bracket) => Some(bracket),
+            Widened::Unbounded => return Ok(unbounded),
+            Widened::BelowStart => None,
+        },
+        None => None,
+    };
+    let bracket = match bracket {
+        Some(bracket) => bracket,
+        None => match scan_from_start(solver, &f, speed_rpm, options)? {
+            Some(bracket) => bracket,
+            None => return Ok(unbounded),
+        },
+    };
+    let bracket = illinois(bracket, options.relative_tolerance, MAX_REFINEMENT_STEPS, f)?;
+    let depth_m = bracket.root();
+    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
+    Ok(LobePoint {
+        speed_rpm,
+        depth_m,
+        chatter_hz,
+    })
+}
+
+/// What widening a bracket from a guess found.
+enum Widened {
+    Bracket(Bracket),
+    /// Stable up to the depth ceiling.
+    Unbounded,
+    /// Unstable down to the start depth: the scan from the start decides.
+    BelowStart,
+}
+
+/// Widen geometrically from `guess` until |mu| - 1 changes sign.
+fn widen_from_guess(
+    f: &impl Fn(f64) -> Result<f64>,
+    guess: f64,
+    options: &BoundaryOptions,
+) -> Result<Widened> {
+    let g = f(guess)?;
+    if g < 0.0 {
+        let (mut lo, mut g_lo) = (guess, g);
+        loop {
+            if lo >= options.max_depth_m {
+                return Ok(Widened::Unbounded);
+            }
+            let hi = (lo * options.growth).min(options.max_depth_m);
+            let g_hi = f(hi)?;
+            if g_hi >= 0.0 {
+                return Ok(Widened::Bracket(Bracket::new((lo, g_lo), (hi, g_hi))));
+            }
+            (lo, g_lo) = (hi, g_hi);
+        }
+    }
+    let (mut hi, mut g_hi) = (guess, g);
+    loop {
+        let lo = hi / options.growth;
+        if lo < options.start_depth_m {
+            return Ok(Widened::BelowStart);
+        }
+        let g_lo = f(lo)?;
+        if g_lo < 0.0 {
+            return Ok(Widened::Bracket(Bracket::new((lo, g_lo), (hi, g_hi))));
+        }
+        (hi, g_hi) = (lo, g_lo);
+    }
+}
+
+/// The geometric scan from zero depth and `options.start_depth_m` to the first sign change;
+/// `None` when the cut is stable up to the ceiling. Errors when the structure is unstable.
+fn scan_from_start<S: StabilitySolver + ?Sized>(
+    solver: &S,
+    f: &impl Fn(f64) -> Result<f64>,
+    speed_rpm: f64,
+    options: &BoundaryOptions,
+) -> Result<Option<Bracket>> {
     let mut lo = 0.0;
     let mut g_lo = f(0.0)?;
     if g_lo >= 0.0 {
@@ -136,27 +240,11 @@ pub fn limiting_depth<S: StabilitySolver + ?Sized>(
         g_lo = g_hi;
         hi *= options.growth;
         if hi > options.max_depth_m {
-            return Ok(LobePoint {
-                speed_rpm,
-                depth_m: f64::INFINITY,
-                chatter_hz: f64::NAN,
-            });
+            return Ok(None);
         }
         g_hi = f(hi)?;
     }
-    let bracket = illinois(
-        Bracket::new((lo, g_lo), (hi, g_hi)),
-        options.relative_tolerance,
-        MAX_REFINEMENT_STEPS,
-        f,
-    )?;
-    let depth_m = bracket.root();
-    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
-    Ok(LobePoint {
-        speed_rpm,
-        depth_m,
-        chatter_hz,
-    })
+    Ok(Some(Bracket::new((lo, g_lo), (hi, g_hi))))
 }
 
 /// Limiting depths at many speeds, in parallel; the result does not depend on the thread count.
@@ -194,6 +282,23 @@ pub fn multiplier_grid<S: StabilitySolver + ?Sized>(
                 .map(|&b| Ok(solver.dominant_multiplier(model, s, b)?.modulus()))
                 .collect()
         })
+        .collect()
+}
+
+/// Number of speeds of [`default_speeds_rpm`].
+pub const DEFAULT_SPEED_COUNT: usize = 200;
+
+/// The default speed range of a lobe diagram: [`DEFAULT_SPEED_COUNT`] evenly spaced speeds
+/// around the lobes of the dominant mode ([`dominant_mode_frequency_hz`] f_d), from a tenth of
+/// the maximum to 1.2 f_d x 60 / (delays per revolution) rpm (lobe numbers ~1 to 10), capped at
+/// 60 000 rpm.
+pub fn default_speeds_rpm(model: &ModalModel) -> Vec<f64> {
+    let f = dominant_mode_frequency_hz(model);
+    let n = model.operation().delays_per_revolution() as f64;
+    let max = (60.0 * f / n * 1.2).min(60_000.0);
+    let min = max / 10.0;
+    (0..DEFAULT_SPEED_COUNT)
+        .map(|i| min + (max - min) * i as f64 / (DEFAULT_SPEED_COUNT - 1) as f64)
         .collect()
 }
 

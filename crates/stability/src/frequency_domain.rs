@@ -17,6 +17,7 @@
 use crate::StabilitySolver;
 use crate::error::{Result, StabilityError, check_condition};
 use crate::multiplier::DominantMultiplier;
+use chatter_dynamics::pole::pole_frequency_damping;
 use chatter_dynamics::{ModalModel, Operation};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -46,11 +47,11 @@ pub struct ClosedLoopPole {
 
 impl ClosedLoopPole {
     fn new(lambda: Complex64) -> Self {
-        let w = lambda.norm();
+        let (frequency_hz, damping_ratio) = pole_frequency_damping(lambda);
         Self {
             lambda,
-            frequency_hz: w / (2.0 * PI),
-            damping_ratio: -lambda.re / w,
+            frequency_hz,
+            damping_ratio,
         }
     }
 }

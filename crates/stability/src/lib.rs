@@ -14,6 +14,7 @@ pub mod frequency_domain;
 mod hessenberg;
 pub mod monodromy;
 pub mod multiplier;
+pub mod prepared;
 pub mod process_damping;
 mod root;
 pub mod sensitivity;
@@ -21,6 +22,7 @@ pub mod zero_order;
 
 pub use error::{Result, StabilityError};
 pub use multiplier::{DominantMultiplier, MultiplierKind};
+pub use prepared::{Method, PreparedSolver};
 
 use chatter_dynamics::ModalModel;
 

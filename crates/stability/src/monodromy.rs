@@ -166,8 +166,22 @@ impl StabilitySolver for Discretization {
         speed_rpm: f64,
         depth_m: f64,
     ) -> Result<(DominantMultiplier, f64)> {
+        self.chatter_frequency_from(model, speed_rpm, depth_m, None)
+    }
+}
+
+impl Discretization {
+    /// [`StabilitySolver::chatter_frequency_hz`] with Arnoldi started from `start` (see
+    /// [`Monodromy::dominant_eigenpair_from`]).
+    pub fn chatter_frequency_from(
+        &self,
+        model: &ModalModel,
+        speed_rpm: f64,
+        depth_m: f64,
+        start: Option<&[f64]>,
+    ) -> Result<(DominantMultiplier, f64)> {
         let op = self.monodromy(model, speed_rpm, depth_m)?;
-        let (mu, vector) = op.dominant_eigenpair()?;
+        let (mu, vector) = op.dominant_eigenpair_from(start)?;
         let mu = DominantMultiplier::new(mu, op.period_s);
         let (lo, hi) = model
             .modes()
@@ -702,10 +716,23 @@ impl Monodromy {
     /// the dense operator (up to [`DENSE_FALLBACK_MAX_DIM`]). Tiny operators go to the dense
     /// solver directly.
     pub fn dominant_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
+        self.dominant_eigenpair_from(None)
+    }
+
+    /// [`Self::dominant_eigenpair`] with the first Arnoldi run started from `start` (e.g. the
+    /// real plus imaginary part of the eigenvector of a nearby operator of the same dimension:
+    /// the boundary search at the previous depth), which saves most restarts where the
+    /// multipliers cluster in modulus (low speeds). A start of another dimension is ignored.
+    pub fn dominant_eigenpair_from(
+        &self,
+        start: Option<&[f64]>,
+    ) -> Result<(Complex64, Vec<Complex64>)> {
+        let d = self.dimension();
         robust_eigenpair(
             |x, out| self.apply(x, out),
-            self.dimension(),
+            d,
             || self.dense(),
+            start.filter(|s| s.len() == d),
         )
     }
 
@@ -716,6 +743,7 @@ impl Monodromy {
             |x, out| self.apply_transpose(x, out),
             self.dimension(),
             || self.dense().transpose(),
+            None,
         )
     }
 
@@ -780,20 +808,22 @@ const DENSE_MAX_DIM: usize = 24;
 pub const DENSE_FALLBACK_MAX_DIM: usize = 1600;
 
 /// The dominant eigenpair of the operator `apply` of dimension `d`: dense for tiny operators,
-/// else Arnoldi, a larger Arnoldi and the dense matrix `dense()` in turn.
+/// else Arnoldi (from `start` when given), a larger Arnoldi and the dense matrix `dense()` in
+/// turn.
 fn robust_eigenpair<F: Fn(&[f64], &mut [f64])>(
     apply: F,
     d: usize,
     dense: impl Fn() -> DMatrix<f64>,
+    start: Option<&[f64]>,
 ) -> Result<(Complex64, Vec<Complex64>)> {
     if d <= DENSE_MAX_DIM {
         return dense_eigenpair(dense());
     }
-    let first = match arnoldi(&apply, d, &ArnoldiConfig::DEFAULT) {
+    let first = match arnoldi(&apply, d, &ArnoldiConfig::DEFAULT, start) {
         Ok(pair) => return Ok(pair),
         Err(e) => e,
     };
-    if let Ok(pair) = arnoldi(&apply, d, &ArnoldiConfig::FALLBACK) {
+    if let Ok(pair) = arnoldi(&apply, d, &ArnoldiConfig::FALLBACK, None) {
         return Ok(pair);
     }
     if d <= DENSE_FALLBACK_MAX_DIM {
@@ -904,17 +934,26 @@ fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex6
 
 /// Restarted Arnoldi for the eigenvalue of largest modulus of the operator `apply` of dimension
 /// `d`, with its Ritz vector. Convergence is tested at the Krylov dimensions of
-/// `config.checks`; a cycle that reaches `config.dim` restarts from its Ritz vector.
+/// `config.checks`; a cycle that reaches `config.dim` restarts from its Ritz vector. The first
+/// cycle starts from `initial` when given (and not zero), else from a fixed vector.
 fn arnoldi<F: Fn(&[f64], &mut [f64])>(
     apply: F,
     d: usize,
     config: &ArnoldiConfig,
+    initial: Option<&[f64]>,
 ) -> Result<(Complex64, Vec<Complex64>)> {
     let k = config.dim.min(d - 1);
-    // deterministic start vector
-    let mut start: Vec<f64> = (0..d)
-        .map(|i| 1.0 + 0.5 * ((i as f64) * config.start_phase).sin())
-        .collect();
+    let mut start: Vec<f64> = match initial {
+        Some(v)
+            if v.iter().any(|x| *x != 0.0 && x.is_finite()) && v.iter().all(|x| x.is_finite()) =>
+        {
+            v.to_vec()
+        }
+        // deterministic start vector
+        _ => (0..d)
+            .map(|i| 1.0 + 0.5 * ((i as f64) * config.start_phase).sin())
+            .collect(),
+    };
     let mut previous: Option<Complex64> = None;
     let mut v = vec![vec![0.0; d]; k + 1];
     let mut w = vec![0.0; d];
@@ -1075,10 +1114,10 @@ mod tests {
                     };
                 }
             };
-            assert!(arnoldi(apply, d, &ArnoldiConfig::DEFAULT).is_err());
+            assert!(arnoldi(apply, d, &ArnoldiConfig::DEFAULT, None).is_err());
             calls.set(0);
             let dense = || DMatrix::from_fn(d, d, |i, j| if i == j { diagonal(i) } else { 0.0 });
-            let (mu, _) = robust_eigenpair(apply, d, dense).unwrap();
+            let (mu, _) = robust_eigenpair(apply, d, dense, None).unwrap();
             assert!((mu - 0.9).norm() < 1e-10, "{bad}: {mu}");
         }
     }

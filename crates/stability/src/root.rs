@@ -59,6 +59,24 @@ impl Bracket {
             || (self.positive - self.negative).abs() <= relative_tolerance * scale
     }
 
+    /// `x` moved, where it lies closer than a quarter of the tolerance width to an end, that far
+    /// inside (Brent's minimum step): once the false-position point sits on the root, the next
+    /// step lands just across it and closes the bracket, instead of creeping up to the root from
+    /// one side while the other end stays put.
+    fn at_least_from_ends(&self, x: f64, relative_tolerance: f64) -> f64 {
+        let scale = self.negative.abs().max(self.positive.abs());
+        let delta = 0.25 * relative_tolerance * scale;
+        let (lo, hi) = if self.negative < self.positive {
+            (self.negative, self.positive)
+        } else {
+            (self.positive, self.negative)
+        };
+        if hi - lo <= 2.0 * delta {
+            return self.midpoint();
+        }
+        x.clamp(lo + delta, hi - delta)
+    }
+
     /// The false-position point, or the midpoint where that is not strictly inside (infinite or
     /// equal end values).
     fn false_position(&self) -> f64 {
@@ -86,7 +104,7 @@ pub(crate) fn illinois<E>(
         if bracket.converged(relative_tolerance) {
             break;
         }
-        let x = bracket.false_position();
+        let x = bracket.at_least_from_ends(bracket.false_position(), relative_tolerance);
         let fx = f(x)?;
         if fx < 0.0 {
             bracket.negative = x;

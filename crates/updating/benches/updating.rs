@@ -1,13 +1,18 @@
 //! Sampler benches on the seeds' cases: 5000 iTMCMC samples of the 000 turning case (one model
 //! class, the exact characteristic-equation likelihood; target < 5 s on 2 cores) and TMCMC on the
 //! 002 milling case with the exact monodromy likelihood (fewer samples; the time scales linearly).
-//! Also the zero-order limiting depth at one speed that the ensembles call thousands of times,
-//! without and with process damping (seed-001 milling with a 19.05 mm cutter, C = 1e5 N/m).
+//! Also the limiting depth at one speed that the ensembles call thousands of times, zero-order
+//! (before issue 14) and full discretization (the default since), without and with process
+//! damping (seed-001 milling with a 19.05 mm cutter, C = 1e5 N/m), and one evaluation of the
+//! 003 cut likelihood on the process-damping flexure (cuts at 300, 700 and 1100 rpm) with each.
 
+use chatter_dynamics::Cut;
 use chatter_dynamics::{Milling, MillingDirection, Operation, examples};
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::prepared::Method;
 use chatter_updating::boundary::{BoundaryOptions, limiting_depth};
 use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
+use chatter_updating::cuts::{CutKernel, CutsLikelihood};
 use chatter_updating::milling::MillingPoleLikelihood;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
 use chatter_updating::turning::{ResidualForm, TurningPoleLikelihood, expand_repetitions};
@@ -86,17 +91,71 @@ fn boundary(c: &mut Criterion) {
         .and_then(|op| bare.with_operation(Operation::Milling(op)))
         .and_then(|m| m.with_process_damping(Some(1e5)))
         .unwrap_or_else(|e| panic!("{e}"));
-    let options = BoundaryOptions::default();
+    let zoa = BoundaryOptions {
+        method: Method::Zoa,
+        ..Default::default()
+    };
+    let fdm = BoundaryOptions::default();
     let mut group = c.benchmark_group("boundary");
     group.sample_size(20);
     group.bench_function("limiting_depth_milling_2_modes", |b| {
-        b.iter(|| limiting_depth(&bare, black_box(6960.0), &options))
+        b.iter(|| limiting_depth(&bare, black_box(6960.0), &zoa))
     });
     group.bench_function("limiting_depth_process_damping", |b| {
-        b.iter(|| limiting_depth(&cutter, black_box(3000.0), &options))
+        b.iter(|| limiting_depth(&cutter, black_box(3000.0), &zoa))
+    });
+    group.bench_function("limiting_depth_milling_2_modes_fdm", |b| {
+        b.iter(|| limiting_depth(&bare, black_box(6960.0), &fdm))
+    });
+    group.bench_function("limiting_depth_process_damping_fdm", |b| {
+        b.iter(|| limiting_depth(&cutter, black_box(3000.0), &fdm))
     });
     group.finish();
 }
 
-criterion_group!(benches, ahmadi_2022, ebrahimi_2025, boundary);
+/// One evaluation of the 003 cut likelihood (kt, kn, C) on the flexure, per method.
+fn cut_likelihood(c: &mut Criterion) {
+    let flexure = examples::process_damping_flexure(Some(2.5e5));
+    let p = Parameterization::new(
+        flexure,
+        parse_model_parameters("kt_n_per_mm2,kn_n_per_mm2,c_n_per_m").unwrap_or_default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let cuts: Vec<Cut> = [(300.0, 2.5, true), (700.0, 1.5, false), (1100.0, 1.2, true)]
+        .into_iter()
+        .map(|(speed_rpm, depth_mm, stable)| Cut {
+            speed_rpm,
+            depth_mm,
+            stable,
+            chatter_hz: None,
+            sequence: None,
+            radial_immersion: None,
+            note: None,
+        })
+        .collect();
+    let theta = [2150.0, 1040.0, 2.8e5];
+    let mut group = c.benchmark_group("cut_likelihood_003");
+    group.sample_size(20);
+    for method in [Method::Zoa, Method::Fdm] {
+        let options = BoundaryOptions {
+            method,
+            max_depth_m: 7.5e-3,
+            ..Default::default()
+        };
+        let like = CutsLikelihood::new(p.clone(), cuts.clone(), CutKernel::karandikar(), options)
+            .unwrap_or_else(|e| panic!("{e}"));
+        group.bench_function(method.name(), |b| {
+            b.iter(|| like.ln_likelihood(black_box(&theta)))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    ahmadi_2022,
+    ebrahimi_2025,
+    boundary,
+    cut_likelihood
+);
 criterion_main!(benches);

@@ -81,7 +81,8 @@ impl CutKernel {
 
 /// The cut-result likelihood of a set of cuts as a function of the model parameters (for the
 /// samplers): the product of [`CutKernel::ln_likelihood`] over the cuts, each with the sampled
-/// model's zero-order boundary (with process damping, [`crate::boundary`]) at its speed.
+/// model's boundary at its speed ([`crate::boundary`]: full discretization with process damping
+/// by default, on the nominal model's grid).
 #[derive(Debug, Clone)]
 pub struct CutsLikelihood {
     parameterization: Parameterization,
@@ -151,7 +152,8 @@ impl CutsLikelihood {
             .parameterization
             .model(theta)
             .map_err(|_| LikelihoodFailure::OutsideSupport)?;
-        let boundaries = limiting_depths(&model, &self.speeds_rpm, &self.options)
+        let grid = self.parameterization.nominal();
+        let boundaries = limiting_depths(&model, grid, &self.speeds_rpm, &self.options)
             .map_err(|_| LikelihoodFailure::Numerical)?;
         Ok(self
             .cuts

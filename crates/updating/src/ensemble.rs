@@ -264,11 +264,12 @@ impl BoundaryEnsemble {
         }
         let done = std::sync::atomic::AtomicUsize::new(0);
         let total = self.models.len();
+        let grid = self.parameterization.nominal();
         let per_path: Vec<Vec<LobePoint>> = self
             .models
             .par_iter()
             .map(|m| {
-                let row = limiting_depths(m, &new, &self.options);
+                let row = limiting_depths(m, grid, &new, &self.options);
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 observer.paths_done(k, total);
                 row

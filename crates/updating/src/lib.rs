@@ -8,7 +8,7 @@
 //! | [`milling`] | identified Floquet multipliers (frequency, damping) against the exact discretized monodromy operator, sigma_zeta = alpha sigma_w | 002 Eq. 13-15 |
 //! | [`cuts`] | stable / chatter results with chatter frequency; the one-sided kernel | 004 Eq. 5, 003 Eq. 3-4 |
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
-//! | [`boundary`] | fast zero-order limiting depth with process damping (fixed point of 003's iteration) | 003 Section 2 |
+//! | [`boundary`] | limiting depths of sampled models: full discretization with process damping, prepared per model, on the nominal grid | 000 Eq. 9-11, 003 Eq. 1 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
 //! | [`defaults`] | the papers' priors, model classes and parameter choice | 000 Section 6, 002 Section 3.2, 003 |
 //! | [`update`], [`plan`] | the jobs behind `chatter update` and `chatter plan` | |

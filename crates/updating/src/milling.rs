@@ -23,6 +23,7 @@
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_bayes::LikelihoodFailure;
+use chatter_dynamics::pole::pole_frequency_damping;
 use chatter_dynamics::{ModalModel, Operation, PoleObservation};
 use chatter_stability::DominantMultiplier;
 use chatter_stability::monodromy::Discretization;
@@ -31,13 +32,7 @@ use std::f64::consts::PI;
 /// The frequency (Hz, |lambda| / 2 pi) and damping ratio (-Re lambda / |lambda|) of a multiplier
 /// over its period (002 Section 2.1).
 pub fn multiplier_frequency_damping(mu: &DominantMultiplier) -> (f64, f64) {
-    let lambda = mu.exponent();
-    let w = lambda.norm();
-    if w > 0.0 {
-        (w / (2.0 * PI), -lambda.re / w)
-    } else {
-        (0.0, 1.0)
-    }
+    pole_frequency_damping(mu.exponent())
 }
 
 /// One cutting condition with the statistics of its identified poles.

@@ -33,6 +33,7 @@
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_bayes::LikelihoodFailure;
+use chatter_dynamics::pole::pole_from_frequency_damping;
 use chatter_dynamics::{ModalModel, Operation, PoleObservation};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -57,11 +58,10 @@ impl ObservedPole {
         frequency_hz: f64,
         zeta: f64,
     ) -> Self {
-        let w = 2.0 * PI * frequency_hz;
         Self {
             speed_rpm,
             depth_m,
-            lambda: Complex64::new(-zeta * w, w * (1.0 - zeta * zeta).max(0.0).sqrt()),
+            lambda: pole_from_frequency_damping(frequency_hz, zeta),
         }
     }
 }

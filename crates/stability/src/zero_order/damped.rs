@@ -42,6 +42,7 @@ use super::{Lobe, ZeroOrderOptions};
 use crate::error::{Result, invalid};
 use crate::root::{Bracket, illinois};
 use num_complex::Complex64;
+use std::borrow::Cow;
 use std::cell::{Cell, OnceCell};
 use std::convert::Infallible;
 use std::f64::consts::PI;
@@ -67,7 +68,7 @@ const FREQUENCY_FRACTION: f64 = 1e-2;
 /// the process-damped lobes at any speed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProcessDampedTable<'a> {
-    table: &'a LobeTable,
+    table: Cow<'a, LobeTable>,
     slopes_per_m: Vec<f64>,
     options: ZeroOrderOptions,
     /// The grid of u (m, at unit scale), ascending.
@@ -114,6 +115,28 @@ impl<'a> ProcessDampedTable<'a> {
     /// s_n = `slopes_per_m` (one per mode, >= 0, at least one > 0) the slopes at unit scale.
     pub fn new(
         table: &'a LobeTable,
+        slopes_per_m: &[f64],
+        options: &ZeroOrderOptions,
+    ) -> Result<Self> {
+        Self::build(Cow::Borrowed(table), slopes_per_m, options)
+    }
+
+    /// [`Self::new`] owning its table (for a solver prepared once per model).
+    pub fn owning(
+        table: LobeTable,
+        slopes_per_m: &[f64],
+        options: &ZeroOrderOptions,
+    ) -> Result<ProcessDampedTable<'static>> {
+        ProcessDampedTable::build(Cow::Owned(table), slopes_per_m, options)
+    }
+
+    /// The underlying table without process damping.
+    pub fn table(&self) -> &LobeTable {
+        &self.table
+    }
+
+    fn build(
+        table: Cow<'a, LobeTable>,
         slopes_per_m: &[f64],
         options: &ZeroOrderOptions,
     ) -> Result<Self> {
@@ -405,7 +428,7 @@ impl<'t, 'a> AtScale<'t, 'a> {
     /// b(w) stays finite, so such a lobe can be low. The fold is found by bisection in w,
     /// following the branch from the grid point.
     fn fold_lobes(&self, tau: f64, below: f64) -> Vec<Lobe> {
-        let table = self.damped.table;
+        let table = &*self.damped.table;
         let mut out = Vec::new();
         for (branch, estimates) in self.estimates.iter().enumerate() {
             for j in 0..estimates.len().saturating_sub(1) {

@@ -96,9 +96,76 @@ impl ZeroOrderOptions {
     }
 }
 
+/// The zero-order method prepared for one model: its [`LobeTable`] and, when the model has
+/// process damping, its [`ProcessDampedTable`], built once and queried at any speed.
+#[derive(Debug, Clone)]
+pub struct PreparedZeroOrder {
+    model: ModalModel,
+    tables: Tables,
+    options: ZeroOrderOptions,
+}
+
+/// The tables of a prepared model.
+#[derive(Debug, Clone)]
+enum Tables {
+    Bare(LobeTable),
+    Damped(ProcessDampedTable<'static>),
+}
+
+impl PreparedZeroOrder {
+    /// Tabulate `model` (with its process damping, 003, when it has one).
+    pub fn new(model: &ModalModel, options: &ZeroOrderOptions) -> Result<Self> {
+        options.validate()?;
+        let table = LobeTable::new(OrientedSystem::from_model(model)?);
+        // the slopes at unit C / V, scaled by C / V at each speed
+        let per_cv = damping_ratio_slopes_per_cv(model);
+        let tables = if model.process_damping_n_per_m().is_some() && per_cv.iter().any(|s| *s > 0.0)
+        {
+            Tables::Damped(ProcessDampedTable::owning(table, &per_cv, options)?)
+        } else {
+            Tables::Bare(table)
+        };
+        Ok(Self {
+            model: model.clone(),
+            tables,
+            options: *options,
+        })
+    }
+
+    /// The model this solver was prepared for.
+    pub fn model(&self) -> &ModalModel {
+        &self.model
+    }
+
+    /// The limiting depth at `speed_rpm`; infinite where the cut is stable up to the options'
+    /// depth ceiling.
+    pub fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
+        check_condition(speed_rpm, 0.0)?;
+        let tau = self.model.operation().delay_s(speed_rpm);
+        let lobes = match &self.tables {
+            Tables::Damped(d) => {
+                d.lobes(tau, self.model.process_damping_per_width(speed_rpm), 1)?
+            }
+            Tables::Bare(t) => t.lobes(tau, 1)?,
+        };
+        Ok(match lobes.first() {
+            Some(l) if l.depth_m <= self.options.max_depth_m => LobePoint {
+                speed_rpm,
+                depth_m: l.depth_m,
+                chatter_hz: l.chatter_hz,
+            },
+            _ => LobePoint {
+                speed_rpm,
+                depth_m: f64::INFINITY,
+                chatter_hz: f64::NAN,
+            },
+        })
+    }
+}
+
 /// Zero-order limiting depths at `speeds_rpm`, with the model's process damping (003) when it
 /// has one; `depth_m` is infinite where the cut is stable up to `options.max_depth_m`. One
-/// [`LobeTable`] serves every speed.
+/// [`PreparedZeroOrder`] serves every speed.
 pub fn limiting_depths(
     model: &ModalModel,
     speeds_rpm: &[f64],
@@ -108,35 +175,10 @@ pub fn limiting_depths(
     for &s in speeds_rpm {
         check_condition(s, 0.0)?;
     }
-    let table = LobeTable::new(OrientedSystem::from_model(model)?);
-    // the slopes at unit C / V, scaled by C / V at each speed
-    let per_cv = damping_ratio_slopes_per_cv(model);
-    let damped = if model.process_damping_n_per_m().is_some() && per_cv.iter().any(|s| *s > 0.0) {
-        Some(ProcessDampedTable::new(&table, &per_cv, options)?)
-    } else {
-        None
-    };
+    let prepared = PreparedZeroOrder::new(model, options)?;
     speeds_rpm
         .iter()
-        .map(|&speed_rpm| {
-            let tau = model.operation().delay_s(speed_rpm);
-            let lobes = match &damped {
-                Some(d) => d.lobes(tau, model.process_damping_per_width(speed_rpm), 1)?,
-                None => table.lobes(tau, 1)?,
-            };
-            Ok(match lobes.first() {
-                Some(l) if l.depth_m <= options.max_depth_m => LobePoint {
-                    speed_rpm,
-                    depth_m: l.depth_m,
-                    chatter_hz: l.chatter_hz,
-                },
-                _ => LobePoint {
-                    speed_rpm,
-                    depth_m: f64::INFINITY,
-                    chatter_hz: f64::NAN,
-                },
-            })
-        })
+        .map(|&speed_rpm| prepared.limiting_depth(speed_rpm))
         .collect()
 }
 

@@ -1,0 +1,434 @@
+//! Prepared solvers: each method is prepared once per model and then queried at any cutting
+//! condition (the planner of RustFFT, the problem/solver split of argmin).
+//!
+//! | method | prepared once | per query |
+//! |---|---|---|
+//! | [`Method::Zoa`] ([`PreparedZeroOrder`]) | the eigenvalue branches of A_0 G(i w) on a frequency grid, with process damping (001, 003) | the lowest lobe crossing at the speed's delay |
+//! | [`Method::Fdm`], [`Method::Sdm`] ([`PreparedDiscretization`]) | the step resolution policy (own model or a reference grid) and the zero-order table that guides the boundary search | the step program and its dominant multiplier (000 Eq. 9-11, 002 Eq. 3-5) |
+//! | [`PreparedFrequencyDomain`] (turning) | the zero-order guide | the closed-loop poles of the characteristic equation (000 Eq. 28) |
+//!
+//! Every prepared solver answers the same four queries ([`PreparedSolver`]): the dominant
+//! multiplier, the chatter frequency, the limiting depth and the lobes over speeds. The
+//! zero-order method gives limiting depths only; its multiplier queries are a typed
+//! [`StabilityError::Unsupported`], never a made-up value.
+//!
+//! The discretizations search the boundary from the zero-order limit
+//! ([`crate::boundary::limiting_depth_near`]): a handful of multiplier evaluations per speed
+//! instead of the ~30 of a scan from zero depth.
+//!
+//! ```
+//! use chatter_dynamics::examples;
+//! use chatter_stability::boundary::BoundaryOptions;
+//! use chatter_stability::prepared::Method;
+//! let model = examples::schmitz_2023_milling();
+//! let options = BoundaryOptions::default();
+//! let zoa = Method::Zoa.prepare(&model, &options)?;
+//! let fdm = Method::Fdm.prepare(&model, &options)?;
+//! let (a, b) = (zoa.limiting_depth(6960.0)?, fdm.limiting_depth(6960.0)?);
+//! // the two methods agree on this two-mode mill within a few percent
+//! assert!((a.depth_m - b.depth_m).abs() < 0.1 * b.depth_m, "{a:?} {b:?}");
+//! assert!(zoa.dominant_multiplier(6960.0, 1e-3).is_err());
+//! assert!(fdm.dominant_multiplier(6960.0, 0.5 * b.depth_m)?.modulus() < 1.0);
+//! # Ok::<(), chatter_stability::StabilityError>(())
+//! ```
+
+use crate::StabilitySolver;
+use crate::boundary::{BoundaryObserver, BoundaryOptions, LobePoint, limiting_depth_near};
+use crate::error::{Result, StabilityError};
+use crate::frequency_domain::FrequencyDomain;
+use crate::monodromy::Discretization;
+use crate::multiplier::DominantMultiplier;
+use crate::zero_order::{PreparedZeroOrder, ZeroOrderOptions};
+use chatter_dynamics::{ModalModel, Operation};
+use rayon::prelude::*;
+use std::sync::Mutex;
+
+/// A stability method by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Zero-order approximation (Altintas-Budak; exact for turning).
+    Zoa,
+    /// First-order full discretization.
+    Fdm,
+    /// First-order semi-discretization.
+    Sdm,
+}
+
+impl Method {
+    /// Short name (`"zoa"`, `"fdm"`, `"sdm"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Zoa => "zoa",
+            Method::Fdm => "fdm",
+            Method::Sdm => "sdm",
+        }
+    }
+
+    /// The discretization of FDM and SDM at the automatic resolution; `None` for zero-order.
+    pub fn discretization(self) -> Option<Discretization> {
+        match self {
+            Method::Zoa => None,
+            Method::Fdm => Some(Discretization::full()),
+            Method::Sdm => Some(Discretization::semi()),
+        }
+    }
+
+    /// The method prepared for `model` with the boundary `options` (depth ceiling, tolerance).
+    pub fn prepare(
+        self,
+        model: &ModalModel,
+        options: &BoundaryOptions,
+    ) -> Result<Box<dyn PreparedSolver>> {
+        Ok(match self.discretization() {
+            None => Box::new(PreparedZeroOrder::new(model, &zero_order_options(options))?),
+            Some(d) => Box::new(PreparedDiscretization::new(d, model, options)?),
+        })
+    }
+}
+
+/// A stability method prepared for one model.
+///
+/// Implementations are thread-safe and deterministic: [`Self::lobes`] runs speeds in parallel
+/// and gives the same result on any number of threads.
+pub trait PreparedSolver: Send + Sync {
+    /// Short name (`"zoa"`, `"fdm"`, `"sdm"`, `"frequency-domain"`).
+    fn name(&self) -> &'static str;
+
+    /// The model the solver was prepared for.
+    fn model(&self) -> &ModalModel;
+
+    /// Dominant multiplier over one delay at `speed_rpm` and depth `depth_m`.
+    fn dominant_multiplier(&self, speed_rpm: f64, depth_m: f64) -> Result<DominantMultiplier>;
+
+    /// The dominant multiplier with its chatter frequency (Hz).
+    fn chatter_frequency_hz(
+        &self,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)>;
+
+    /// The limiting depth at `speed_rpm` (infinite when stable up to the depth ceiling).
+    fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint>;
+
+    /// Limiting depths at `speeds_rpm`, in parallel; `observer` hears of each speed done.
+    fn lobes(&self, speeds_rpm: &[f64], observer: &dyn BoundaryObserver) -> Result<Vec<LobePoint>> {
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        speeds_rpm
+            .par_iter()
+            .map(|&s| {
+                let p = self.limiting_depth(s);
+                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                observer.speed_done(k, speeds_rpm.len());
+                p
+            })
+            .collect()
+    }
+}
+
+/// The zero-order options of a boundary search: the same ceiling and tolerance.
+fn zero_order_options(options: &BoundaryOptions) -> ZeroOrderOptions {
+    ZeroOrderOptions {
+        max_depth_m: options.max_depth_m,
+        relative_tolerance: options.relative_tolerance,
+    }
+}
+
+/// The zero-order guide of a multiplier-based search; `None` where the zero-order method does
+/// not apply to the model (the search then scans from zero depth: slower, equally exact).
+fn guide(model: &ModalModel, options: &BoundaryOptions) -> Option<PreparedZeroOrder> {
+    PreparedZeroOrder::new(model, &zero_order_options(options)).ok()
+}
+
+/// The guess of a guided search at one speed: the zero-order limit where it is finite.
+fn guess(guide: Option<&PreparedZeroOrder>, speed_rpm: f64) -> Option<f64> {
+    guide
+        .and_then(|g| g.limiting_depth(speed_rpm).ok())
+        .map(|p| p.depth_m)
+        .filter(|b| b.is_finite())
+}
+
+impl PreparedSolver for PreparedZeroOrder {
+    fn name(&self) -> &'static str {
+        "zoa"
+    }
+
+    fn model(&self) -> &ModalModel {
+        PreparedZeroOrder::model(self)
+    }
+
+    fn dominant_multiplier(&self, _speed_rpm: f64, _depth_m: f64) -> Result<DominantMultiplier> {
+        Err(multipliers_unsupported())
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        _speed_rpm: f64,
+        _depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        Err(multipliers_unsupported())
+    }
+
+    fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
+        PreparedZeroOrder::limiting_depth(self, speed_rpm)
+    }
+}
+
+fn multipliers_unsupported() -> StabilityError {
+    StabilityError::Unsupported {
+        method: "zoa",
+        reason: "the zero-order method gives limiting depths, not multipliers; use fdm or sdm"
+            .into(),
+    }
+}
+
+/// Full- or semi-discretization prepared for one model.
+///
+/// The step count at each speed follows the discretization's [`crate::monodromy::StepsPerDelay`]
+/// on the model itself, or, after [`Self::on_grid_of`], on a reference model: samplers give every
+/// sampled model the grid of the nominal one, so that their operators have the same dimension and
+/// the limiting depth is a smooth function of the parameters.
+#[derive(Debug, Clone)]
+pub struct PreparedDiscretization {
+    model: ModalModel,
+    discretization: Discretization,
+    grid: Option<ModalModel>,
+    guide: Option<PreparedZeroOrder>,
+    options: BoundaryOptions,
+}
+
+impl PreparedDiscretization {
+    /// Prepare `discretization` for `model` with the boundary `options`.
+    pub fn new(
+        discretization: Discretization,
+        model: &ModalModel,
+        options: &BoundaryOptions,
+    ) -> Result<Self> {
+        options.validate()?;
+        Ok(Self {
+            model: model.clone(),
+            discretization,
+            grid: None,
+            guide: guide(model, options),
+            options: *options,
+        })
+    }
+
+    /// Resolve the grid at every speed on `reference` instead of the model.
+    pub fn on_grid_of(self, reference: &ModalModel) -> Self {
+        Self {
+            grid: Some(reference.clone()),
+            ..self
+        }
+    }
+
+    /// The discretization with the step count fixed for `speed_rpm`.
+    pub fn at_speed(&self, speed_rpm: f64) -> Result<Discretization> {
+        self.discretization
+            .resolved(self.grid.as_ref().unwrap_or(&self.model), speed_rpm)
+    }
+}
+
+impl PreparedSolver for PreparedDiscretization {
+    fn name(&self) -> &'static str {
+        self.discretization.name()
+    }
+
+    fn model(&self) -> &ModalModel {
+        &self.model
+    }
+
+    fn dominant_multiplier(&self, speed_rpm: f64, depth_m: f64) -> Result<DominantMultiplier> {
+        self.at_speed(speed_rpm)?
+            .dominant_multiplier(&self.model, speed_rpm, depth_m)
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        self.at_speed(speed_rpm)?
+            .chatter_frequency_hz(&self.model, speed_rpm, depth_m)
+    }
+
+    fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
+        let solver = WarmStarted {
+            discretization: self.at_speed(speed_rpm)?,
+            start: Mutex::new(None),
+        };
+        limiting_depth_near(
+            &solver,
+            &self.model,
+            speed_rpm,
+            guess(self.guide.as_ref(), speed_rpm),
+            &self.options,
+        )
+    }
+}
+
+/// A discretization whose Arnoldi runs start from the eigenvector of the previous call: along
+/// one boundary search the operators differ only in depth and share their dimension, so the
+/// previous eigenvector is a close start (the result is the same to the Arnoldi tolerance).
+struct WarmStarted {
+    discretization: Discretization,
+    start: Mutex<Option<Vec<f64>>>,
+}
+
+impl StabilitySolver for WarmStarted {
+    fn name(&self) -> &'static str {
+        self.discretization.name()
+    }
+
+    fn dominant_multiplier(
+        &self,
+        model: &ModalModel,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<DominantMultiplier> {
+        let op = self.discretization.monodromy(model, speed_rpm, depth_m)?;
+        let mut start = self
+            .start
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let (mu, vector) = op.dominant_eigenpair_from(start.as_deref())?;
+        *start = Some(vector.iter().map(|z| z.re + z.im).collect());
+        Ok(DominantMultiplier::new(mu, op.period_s))
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        model: &ModalModel,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        let start = self
+            .start
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        self.discretization
+            .chatter_frequency_from(model, speed_rpm, depth_m, start.as_deref())
+    }
+}
+
+/// The frequency-domain method (closed-loop poles of turning, 000 Eq. 28) prepared for one
+/// turning model.
+#[derive(Debug, Clone)]
+pub struct PreparedFrequencyDomain {
+    model: ModalModel,
+    guide: Option<PreparedZeroOrder>,
+    options: BoundaryOptions,
+}
+
+impl PreparedFrequencyDomain {
+    /// Prepare for a turning `model`; milling models are [`StabilityError::Unsupported`].
+    pub fn new(model: &ModalModel, options: &BoundaryOptions) -> Result<Self> {
+        options.validate()?;
+        if !matches!(model.operation(), Operation::Turning(_)) {
+            return Err(StabilityError::Unsupported {
+                method: "frequency-domain",
+                reason: "the characteristic equation has constant coefficients only in turning"
+                    .into(),
+            });
+        }
+        Ok(Self {
+            model: model.clone(),
+            guide: guide(model, options),
+            options: *options,
+        })
+    }
+}
+
+impl PreparedSolver for PreparedFrequencyDomain {
+    fn name(&self) -> &'static str {
+        FrequencyDomain.name()
+    }
+
+    fn model(&self) -> &ModalModel {
+        &self.model
+    }
+
+    fn dominant_multiplier(&self, speed_rpm: f64, depth_m: f64) -> Result<DominantMultiplier> {
+        FrequencyDomain.dominant_multiplier(&self.model, speed_rpm, depth_m)
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        FrequencyDomain.chatter_frequency_hz(&self.model, speed_rpm, depth_m)
+    }
+
+    fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
+        limiting_depth_near(
+            &FrequencyDomain,
+            &self.model,
+            speed_rpm,
+            guess(self.guide.as_ref(), speed_rpm),
+            &self.options,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::limiting_depth;
+    use chatter_dynamics::examples;
+
+    /// The guided search finds the same boundary as the scan from zero depth (to the search
+    /// tolerance, 1e-4 relative, twice for the two brackets), with process damping too.
+    #[test]
+    fn guided_search_agrees_with_the_scan() {
+        let options = BoundaryOptions::default();
+        let flexure = examples::process_damping_flexure(Some(2.5e5));
+        let mill = examples::schmitz_2023_milling();
+        for (model, speed) in [(&flexure, 300.0), (&flexure, 2000.0), (&mill, 6960.0)] {
+            let prepared =
+                PreparedDiscretization::new(Discretization::full(), model, &options).unwrap();
+            let guided = PreparedSolver::limiting_depth(&prepared, speed).unwrap();
+            let scanned = limiting_depth(&Discretization::full(), model, speed, &options).unwrap();
+            assert!(
+                (guided.depth_m - scanned.depth_m).abs() < 2e-4 * scanned.depth_m,
+                "{guided:?} {scanned:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn frequency_domain_is_for_turning_and_zoa_has_no_multipliers() {
+        let options = BoundaryOptions::default();
+        let mill = examples::schmitz_2023_milling();
+        assert!(PreparedFrequencyDomain::new(&mill, &options).is_err());
+        let zoa = Method::Zoa.prepare(&mill, &options).unwrap();
+        assert!(matches!(
+            zoa.chatter_frequency_hz(6960.0, 1e-3),
+            Err(StabilityError::Unsupported { .. })
+        ));
+    }
+
+    /// A reference grid fixes the step count: a model 5 % stiffer gets the nominal's grid.
+    #[test]
+    fn reference_grid_is_the_nominal_one() {
+        let nominal = examples::process_damping_flexure(None);
+        let options = BoundaryOptions::default();
+        let prepared =
+            PreparedDiscretization::new(Discretization::full(), &nominal, &options).unwrap();
+        let at = prepared.at_speed(300.0).unwrap();
+        let modes = nominal
+            .modes()
+            .iter()
+            .map(|m| {
+                chatter_dynamics::Mode::new(1.05 * m.frequency_hz(), m.damping_ratio(), m.shape())
+                    .unwrap()
+            })
+            .collect();
+        let stiffer = nominal.with_modes(modes).unwrap();
+        let on_nominal = PreparedDiscretization::new(Discretization::full(), &stiffer, &options)
+            .unwrap()
+            .on_grid_of(&nominal);
+        assert_eq!(on_nominal.at_speed(300.0).unwrap(), at);
+    }
+}
