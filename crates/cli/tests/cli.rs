@@ -884,12 +884,11 @@ fn detect_labels_simulated_cuts() {
     assert_eq!(cuts[1]["stable"], false, "{out}");
     let f = cuts[1]["chatter_hz"].as_f64().unwrap();
     assert!((740.0..790.0).contains(&f), "{f}");
-    assert!(
-        cuts[1]["note"]
-            .as_str()
-            .unwrap()
-            .starts_with("detect chatter.csv: line")
-    );
+    assert_eq!(cuts[1]["note"], "detect chatter.csv");
+    let evidence = &cuts[1]["evidence"];
+    assert!((evidence["line_hz"].as_f64().unwrap() - f).abs() < 1e-9, "{evidence}");
+    assert!(evidence["margin"].as_f64().unwrap() >= 0.0, "{evidence}");
+    assert!(cuts[0]["evidence"]["margin"].as_f64().unwrap() < 0.0, "{out}");
     assert!(plots.join("detect-1.svg").exists() && plots.join("detect-2.svg").exists());
     // the output is an observations file again
     std::fs::write(dir.path().join("labels.json"), &out).unwrap();

@@ -218,6 +218,7 @@ mod tests {
             sequence,
             radial_immersion,
             note: None,
+            evidence: None,
         }
     }
 

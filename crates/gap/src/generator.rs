@@ -611,6 +611,7 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
                     sequence,
                     radial_immersion: None,
                     note: None,
+                    evidence: None,
                 });
             }
             Entry::Pole {

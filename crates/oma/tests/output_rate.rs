@@ -78,7 +78,6 @@ fn identified(sample_rate_hz: f64, duration_s: f64, seed: u64) -> (f64, f64) {
     let options = IdentifyOptions {
         harmonics: Harmonics::Spindle {
             fundamental_hz: speed_rpm / 60.0,
-            count: 3,
         },
         seed,
         ..IdentifyOptions::default()

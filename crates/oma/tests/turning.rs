@@ -62,7 +62,6 @@ fn check(speed_rpm: f64, depth_mm: f64, duration_s: f64, seed: u64) {
     let options = IdentifyOptions {
         harmonics: Harmonics::Spindle {
             fundamental_hz: speed_rpm / 60.0,
-            count: 3,
         },
         seed,
         ..IdentifyOptions::default()

@@ -160,7 +160,6 @@ fn strong_harmonics_bias_plain_lsce_not_the_modified() {
     ));
     let spindle = run(Harmonics::Spindle {
         fundamental_hz: 180.0,
-        count: 2,
     });
     eprintln!(
         "spindle harmonics: {:?}, order {}",

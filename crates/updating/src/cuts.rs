@@ -184,6 +184,7 @@ mod tests {
             sequence: None,
             radial_immersion: None,
             note: None,
+            evidence: None,
         }
     }
 
