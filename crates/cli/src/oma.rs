@@ -35,7 +35,7 @@ use chatter_oma::lifting::lift_at_period;
 use chatter_oma::signals::Signals;
 use chatter_oma::spectrum::first_singular_value;
 use chatter_oma::{Decimation, Harmonics, Identification, IdentifyOptions, Lifting, identify};
-use plotters::style::{BLUE, RED, RGBColor};
+use plotters::style::{BLUE, RGBColor};
 use std::path::{Path, PathBuf};
 
 /// Lifted channels kept per physical channel.

@@ -177,10 +177,18 @@ pub fn error_bar_panels(
                     BLUE.stroke_width(2),
                 ))
                 .map_err(|e| anyhow!("{e}"))?;
+            // a bar from m - s to m + s with a dot at the mean
             chart
-                .draw_series(pts.iter().map(|&(x, m, s)| {
-                    ErrorBar::new_vertical(x, m - s, m, m + s, BLACK.filled(), 8)
-                }))
+                .draw_series(
+                    pts.iter()
+                        .map(|&(x, m, s)| PathElement::new(vec![(x, m - s), (x, m + s)], BLACK)),
+                )
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .draw_series(
+                    pts.iter()
+                        .map(|&(x, m, _)| Circle::new((x, m), 3, BLACK.filled())),
+                )
                 .map_err(|e| anyhow!("{e}"))?;
         }
         root.present().map_err(|e| anyhow!("{e}"))?;

@@ -8,8 +8,9 @@
 //! correlation is r(i) = c delta(i) + sum_j A_j mu_j^|i| (measurement noise and force
 //! feed-through in the delta) gives the correlation (h * h~ * r)(i), which for
 //! |i| > 2 x [`HALF_WIDTH_PERIODS`] output samples (beyond the support of h * h~) is again
-//! sum_j A'_j mu_j^|i| with the same poles, so dropping those lags
-//! ([`correlation_support_lags`]) leaves the model of 000 Eq. 19-20 exact.
+//! sum_j A'_j mu_j^|i| with the same poles; dropping the lags where h * h~ is still above
+//! [`SUPPORT_LEVEL`] of its peak ([`correlation_support_lags`]) leaves the model of 000
+//! Eq. 19-20 exact to that level.
 //!
 //! The filter is a Blackman-windowed sinc of cutoff [`CUTOFF_FRACTION`] of the output rate
 //! (half-amplitude point) and half-width [`HALF_WIDTH_PERIODS`] output periods, normalized to
@@ -28,10 +29,25 @@ pub const HALF_WIDTH_PERIODS: usize = 16;
 /// Blackman transition band 5.5 / (2 x [`HALF_WIDTH_PERIODS`]).
 pub const PASSBAND_FRACTION: f64 = CUTOFF_FRACTION - 5.5 / (4.0 * HALF_WIDTH_PERIODS as f64);
 
+/// Level of the filter's own correlation, relative to its peak, below which the smeared delta
+/// of the noise is neglected (-60 dB).
+pub const SUPPORT_LEVEL: f64 = 1e-3;
+
 /// Correlation lags (in output samples) in which the filter's own correlation h * h~ mixes the
-/// delta at lag 0 (noise, feed-through) into the exponentials: 2 x [`HALF_WIDTH_PERIODS`].
-pub fn correlation_support_lags() -> usize {
-    2 * HALF_WIDTH_PERIODS
+/// delta at lag 0 (noise, feed-through) into the exponentials: the first lag m from which
+/// |(h * h~)(m D)| stays at or below [`SUPPORT_LEVEL`] of (h * h~)(0) (at most
+/// 2 x [`HALF_WIDTH_PERIODS`], the whole support). 1 for `factor` 1.
+pub fn correlation_support_lags(factor: usize) -> usize {
+    if factor <= 1 {
+        return 1;
+    }
+    let h = taps(factor);
+    let at = |lag: usize| -> f64 { h.iter().zip(&h[lag.min(h.len())..]).map(|(a, b)| a * b).sum() };
+    let peak = at(0);
+    (0..=2 * HALF_WIDTH_PERIODS)
+        .rev()
+        .find(|m| at(m * factor).abs() > SUPPORT_LEVEL * peak)
+        .map_or(1, |m| m + 1)
 }
 
 /// The filter taps for decimation by `factor` (odd length 2 x 16 x factor + 1, unit DC gain).
@@ -97,6 +113,9 @@ mod tests {
             assert!(gain(f, 5) < 3e-4, "{f}: {}", gain(f, 5));
         }
         assert_eq!(decimate(&[1.0, 2.0], 1), vec![1.0, 2.0]);
+        let support = correlation_support_lags(10);
+        assert!((2..=2 * HALF_WIDTH_PERIODS).contains(&support), "{support}");
+        assert_eq!(correlation_support_lags(1), 1);
         assert!(decimate(&[1.0; 10], 4).is_empty());
     }
 
