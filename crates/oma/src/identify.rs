@@ -34,17 +34,18 @@
 //!      an unknown fundamental) or a limit cycle always is,
 //!
 //!    are ranked by the rule of [`crate::picking`] (persistent over three quarters of the longest
-//!    run of stable orders; smallest decay rate -Re(lambda) first). The first order of the
-//!    chosen cluster's run of consecutive stable orders (where the pole settles) is the
-//!    identification order unless `order` fixes one.
+//!    run of stable orders; smallest decay rate -Re(lambda) first).
 //! 5. N_s = `segments` windows of `segment_fraction` of the record start at seeded uniform random
-//!    positions; each is identified at that order and contributes the admitted pole nearest the
-//!    cluster's mean lambda (and within 5 times the frequency tolerance of its frequency). A
-//!    cluster found in fewer than [`MIN_SEGMENT_SHARE`] of the segments is not stable across
-//!    segments: the next cluster of the ranking is tried. Mean and sample standard deviation
-//!    over the windows are the reported pole, as in the tables of 000 and 002; the same
-//!    statistics at every order of the diagram are the curves of 000 Fig. 3b/c
-//!    ([`Identification::order_statistics`]).
+//!    positions; each is identified at every order of the diagram and contributes the admitted
+//!    pole nearest the cluster's mean lambda (and within 5 times the frequency tolerance of its
+//!    frequency). Mean and sample standard deviation over the windows at each order are the
+//!    curves of 000 Fig. 3b/c ([`Identification::order_statistics`]); the identification order
+//!    is where they settle (`settled_order`: from the first order of the cluster's run of
+//!    stable orders on, the lowest order from which the means at all higher orders agree under
+//!    the stabilization criteria), else the run's first order, unless `order` fixes one. The
+//!    mean and standard deviation at that order are the reported pole, as in the tables of 000
+//!    and 002. A cluster found in fewer than [`MIN_SEGMENT_SHARE`] of the segments there is not
+//!    stable across segments: the next cluster of the ranking is tried.
 //!
 //! # Automatic correlation window
 //! Unless `max_lag` is given, the correlations span [`LAG_TIME_CONSTANTS`] decay times
@@ -116,6 +117,8 @@ pub const LOWER_EDGE_FRACTION: f64 = 0.01;
 /// Poles within this fraction of the band's upper end from it are at the upper band edge (the
 /// edge of a white or filtered noise spectrum, which LSCE models with lightly damped poles).
 pub const UPPER_EDGE_FRACTION: f64 = 0.1;
+/// Fewest orders over which the segments' mean pole must agree to count as settled.
+pub const MIN_SETTLED_ORDERS: usize = 3;
 /// Smallest share of the segments in which a cluster must be found to count as stable across
 /// segments.
 pub const MIN_SEGMENT_SHARE: f64 = 0.5;
@@ -186,8 +189,7 @@ pub struct IdentifyOptions {
     /// decimation at least [`correlation_support_lags`]).
     pub skip_lags: usize,
     /// Model order of the segment identifications (P for LSCE, harmonics included); default
-    /// `None`: the first order of the dominant cluster's run of consecutive stable orders
-    /// (higher orders fit noise poles that scatter the damping).
+    /// `None`: where the segments' pole settles (step 5 of the module documentation).
     pub order: Option<usize>,
     /// Number N_s of random segments (default 10, >= 1).
     pub segments: usize,
@@ -723,13 +725,10 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
         .collect();
     let mut rejected = pass.rejected.clone();
     for (i, cluster) in pass.candidates.iter().enumerate() {
-        let order = options
-            .order
-            .or_else(|| cluster.members.first().map(|m| m.order))
-            .unwrap_or(top);
+        let run_start = cluster.members.first().map_or(top, |m| m.order);
         // segment correlations by window length, shared by the orders that use it
         let mut by_lags: Vec<(usize, Vec<Correlations>)> = Vec::new();
-        let mut at_order = |n: usize| -> Result<Vec<Pole>> {
+        let mut at_order = |n: usize| -> Result<(usize, Vec<Pole>)> {
             let lags = prepared.window(&pass, i, n, options)?;
             let k = match by_lags.iter().position(|(l, _)| *l == lags) {
                 Some(k) => k,
@@ -747,10 +746,27 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
                 .par_iter()
                 .map(|r| Ok(prepared.matching(prepared.fit(r, n)?, cluster, options)))
                 .collect::<Result<Vec<Option<Pole>>>>()?;
-            Ok(found.into_iter().flatten().collect())
+            Ok((lags, found.into_iter().flatten().collect()))
         };
-        let segment_lags = prepared.window(&pass, i, order, options)?;
-        let segment_poles = at_order(order)?;
+        let mut per_order = Vec::with_capacity(pass.diagram.orders.len());
+        for o in &pass.diagram.orders {
+            per_order.push((o.order, at_order(o.order)?));
+        }
+        let order_statistics: Vec<OrderStatistics> = per_order
+            .iter()
+            .map(|(order, (_, poles))| OrderStatistics {
+                order: *order,
+                estimate: PoleEstimate::from_poles(poles).ok(),
+            })
+            .collect();
+        let order = options
+            .order
+            .or_else(|| settled_order(&order_statistics, run_start, &options.criteria))
+            .unwrap_or(run_start);
+        let (segment_lags, segment_poles) = match per_order.iter().find(|(o, _)| *o == order) {
+            Some((_, found)) => found.clone(),
+            None => at_order(order)?,
+        };
         let found = segment_poles.len();
         if (found as f64) < MIN_SEGMENT_SHARE * options.segments as f64 {
             rejected.push(RejectedCluster {
@@ -764,17 +780,6 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
             continue;
         }
         let estimate = PoleEstimate::from_poles(&segment_poles)?;
-        let order_statistics = pass
-            .diagram
-            .orders
-            .iter()
-            .map(|o| {
-                Ok(OrderStatistics {
-                    order: o.order,
-                    estimate: PoleEstimate::from_poles(&at_order(o.order)?).ok(),
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
         return Ok(Identification {
             estimate,
             segment_poles,
@@ -797,6 +802,47 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
         options.segments,
         describe(&rejected)
     )))
+}
+
+/// The lowest order n >= `from` from which the segments' mean pole has settled (000 Section
+/// 6.1: "at sufficiently high model orders, the identified pole's damping and frequency converge
+/// to a constant value", Fig. 3b/c): at every order >= n that identified it, the mean frequency
+/// and damping agree with their medians over those orders within the relative tolerances of
+/// `criteria` (not its absolute damping floor, which exceeds the whole damping of lightly
+/// damped poles: 5e-4 against 0.0012 on seed 000's P4), and those orders number at least
+/// [`MIN_SETTLED_ORDERS`]. `None` if no such order.
+fn settled_order(
+    stats: &[OrderStatistics],
+    from: usize,
+    criteria: &StabilityCriteria,
+) -> Option<usize> {
+    let criteria = StabilityCriteria {
+        damping_abs: 0.0,
+        ..*criteria
+    };
+    let means: Vec<(usize, f64, f64)> = stats
+        .iter()
+        .filter(|s| s.order >= from)
+        .filter_map(|s| s.estimate.map(|e| (s.order, e.frequency_hz, e.damping_ratio)))
+        .collect();
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let m = v.len() / 2;
+        if v.len() % 2 == 0 {
+            0.5 * (v[m - 1] + v[m])
+        } else {
+            v[m]
+        }
+    };
+    (0..means.len().saturating_sub(MIN_SETTLED_ORDERS - 1))
+        .find(|&k| {
+            let tail = &means[k..];
+            let f = median(tail.iter().map(|m| m.1).collect());
+            let z = median(tail.iter().map(|m| m.2).collect());
+            tail.iter()
+                .all(|m| criteria.same_frequency(m.1, f) && criteria.same_damping(m.2, z))
+        })
+        .map(|k| means[k].0)
 }
 
 /// Correlation lags spanning [`LAG_TIME_CONSTANTS`] decay times -1 / Re(lambda) of the cluster's
