@@ -40,9 +40,10 @@
 //!    pole nearest the cluster's mean lambda (and within 5 times the frequency tolerance of its
 //!    frequency). Mean and sample standard deviation over the windows at each order are the
 //!    curves of 000 Fig. 3b/c ([`Identification::order_statistics`]); the identification order
-//!    is where they settle (`settled_order`: from the first order of the cluster's run of
-//!    stable orders on, the lowest order from which the means at all higher orders agree under
-//!    the stabilization criteria), else the run's first order, unless `order` fixes one. The
+//!    is where they settle (from the first order of the cluster's run of stable orders on, the
+//!    lowest order whose mean agrees with those of the next orders, [`MIN_SETTLED_ORDERS`] in
+//!    all, within the relative stabilization tolerances), else the run's first order, unless
+//!    `order` fixes one. The
 //!    mean and standard deviation at that order are the reported pole, as in the tables of 000
 //!    and 002. A cluster found in fewer than [`MIN_SEGMENT_SHARE`] of the segments there is not
 //!    stable across segments: the next cluster of the ranking is tried.
@@ -117,8 +118,8 @@ pub const LOWER_EDGE_FRACTION: f64 = 0.01;
 /// Poles within this fraction of the band's upper end from it are at the upper band edge (the
 /// edge of a white or filtered noise spectrum, which LSCE models with lightly damped poles).
 pub const UPPER_EDGE_FRACTION: f64 = 0.1;
-/// Fewest orders over which the segments' mean pole must agree to count as settled.
-pub const MIN_SETTLED_ORDERS: usize = 3;
+/// Consecutive orders over which the segments' mean pole must agree to count as settled.
+pub const MIN_SETTLED_ORDERS: usize = 5;
 /// Smallest share of the segments in which a cluster must be found to count as stable across
 /// segments.
 pub const MIN_SEGMENT_SHARE: f64 = 0.5;
@@ -804,13 +805,12 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
     )))
 }
 
-/// The lowest order n >= `from` from which the segments' mean pole has settled (000 Section
-/// 6.1: "at sufficiently high model orders, the identified pole's damping and frequency converge
-/// to a constant value", Fig. 3b/c): at every order >= n that identified it, the mean frequency
-/// and damping agree with their medians over those orders within the relative tolerances of
+/// The lowest order n >= `from` at which the segments' mean pole has settled (000 Section 6.1:
+/// "at sufficiently high model orders, the identified pole's damping and frequency converge to
+/// a constant value", Fig. 3b/c): the means at n and the next orders, [`MIN_SETTLED_ORDERS`]
+/// consecutive orders in all, agree with their median within the relative tolerances of
 /// `criteria` (not its absolute damping floor, which exceeds the whole damping of lightly
-/// damped poles: 5e-4 against 0.0012 on seed 000's P4), and those orders number at least
-/// [`MIN_SETTLED_ORDERS`]. `None` if no such order.
+/// damped poles: 5e-4 against 0.0012 on seed 000's P4). `None` if no such order.
 fn settled_order(
     stats: &[OrderStatistics],
     from: usize,
@@ -834,15 +834,17 @@ fn settled_order(
             v[m]
         }
     };
-    (0..means.len().saturating_sub(MIN_SETTLED_ORDERS - 1))
-        .find(|&k| {
-            let tail = &means[k..];
-            let f = median(tail.iter().map(|m| m.1).collect());
-            let z = median(tail.iter().map(|m| m.2).collect());
-            tail.iter()
-                .all(|m| criteria.same_frequency(m.1, f) && criteria.same_damping(m.2, z))
+    means
+        .windows(MIN_SETTLED_ORDERS)
+        .find(|w| {
+            let consecutive = w.windows(2).all(|p| p[1].0 == p[0].0 + 1);
+            let f = median(w.iter().map(|m| m.1).collect());
+            let z = median(w.iter().map(|m| m.2).collect());
+            consecutive
+                && w.iter()
+                    .all(|m| criteria.same_frequency(m.1, f) && criteria.same_damping(m.2, z))
         })
-        .map(|k| means[k].0)
+        .map(|w| w[0].0)
 }
 
 /// Correlation lags spanning [`LAG_TIME_CONSTANTS`] decay times -1 / Re(lambda) of the cluster's
