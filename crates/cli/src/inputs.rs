@@ -68,4 +68,3 @@ pub fn signal_record(i: usize, record: &SignalRecord) -> Result<Signals> {
         }
     })
 }
-

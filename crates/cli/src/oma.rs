@@ -111,7 +111,8 @@ pub fn run(args: &OmaArgs) -> Result<()> {
             eprintln!("wrote {}", path.display());
             let orders = path.with_file_name(format!(
                 "{}-orders.svg",
-                path.file_stem().map_or_else(|| "oma".into(), |s| s.to_string_lossy())
+                path.file_stem()
+                    .map_or_else(|| "oma".into(), |s| s.to_string_lossy())
             ));
             draw_orders(&orders, record, &analysis).with_context(context)?;
             eprintln!("wrote {}", orders.display());
@@ -265,12 +266,11 @@ fn pole_observation(record: &SignalRecord, a: &Analysis) -> PoleObservation {
     let rejected = if a.id.rejected.is_empty() {
         String::new()
     } else {
-        let list: Vec<String> = a
-            .id
-            .rejected
-            .iter()
-            .map(|r| format!("{:.1} Hz ({:?})", r.frequency_hz, r.reason))
-            .collect();
+        let list: Vec<String> =
+            a.id.rejected
+                .iter()
+                .map(|r| format!("{:.1} Hz ({:?})", r.frequency_hz, r.reason))
+                .collect();
         format!(", rejected {}", list.join(", "))
     };
     let flag = a.chatter_hz.map_or_else(String::new, |f| {
@@ -424,12 +424,11 @@ fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
 /// and damping ratio at every model order of the diagram; the order used is in the title.
 fn draw_orders(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
     let lifted = a.lifting.is_some();
-    let stats: Vec<(f64, chatter_oma::identify::PoleEstimate)> = a
-        .id
-        .order_statistics
-        .iter()
-        .filter_map(|s| s.estimate.map(|e| (s.order as f64, e)))
-        .collect();
+    let stats: Vec<(f64, chatter_oma::identify::PoleEstimate)> =
+        a.id.order_statistics
+            .iter()
+            .filter_map(|s| s.estimate.map(|e| (s.order as f64, e)))
+            .collect();
     let frequency = |e: &chatter_oma::identify::PoleEstimate| {
         if lifted {
             e.principal_frequency_hz
@@ -461,7 +460,10 @@ fn draw_orders(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
         path,
         &format!(
             "{} rpm, {} mm: pole over {} segments by model order (order used: {})",
-            record.speed_rpm, record.depth_mm, a.id.segment_poles.len(), a.id.order
+            record.speed_rpm,
+            record.depth_mm,
+            a.id.segment_poles.len(),
+            a.id.order
         ),
         "model order",
         &panels,

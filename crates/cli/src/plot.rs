@@ -154,11 +154,13 @@ pub fn error_bar_panels(
                 .copied()
                 .filter(|p| p.0.is_finite() && p.1.is_finite() && p.2.is_finite())
                 .collect();
-            let (y0, y1) = finite_range(pts.iter().flat_map(|p| [p.1 - p.2, p.1 + p.2]))
-                .map_or((0.0, 1.0), |(a, b)| {
+            let (y0, y1) = finite_range(pts.iter().flat_map(|p| [p.1 - p.2, p.1 + p.2])).map_or(
+                (0.0, 1.0),
+                |(a, b)| {
                     let pad = 0.05 * (b - a);
                     (a - pad, b + pad)
-                });
+                },
+            );
             let mut chart = ChartBuilder::on(area)
                 .margin(15)
                 .x_label_area_size(40)

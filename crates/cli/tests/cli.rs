@@ -886,9 +886,15 @@ fn detect_labels_simulated_cuts() {
     assert!((740.0..790.0).contains(&f), "{f}");
     assert_eq!(cuts[1]["note"], "detect chatter.csv");
     let evidence = &cuts[1]["evidence"];
-    assert!((evidence["line_hz"].as_f64().unwrap() - f).abs() < 1e-9, "{evidence}");
+    assert!(
+        (evidence["line_hz"].as_f64().unwrap() - f).abs() < 1e-9,
+        "{evidence}"
+    );
     assert!(evidence["margin"].as_f64().unwrap() >= 0.0, "{evidence}");
-    assert!(cuts[0]["evidence"]["margin"].as_f64().unwrap() < 0.0, "{out}");
+    assert!(
+        cuts[0]["evidence"]["margin"].as_f64().unwrap() < 0.0,
+        "{out}"
+    );
     assert!(plots.join("detect-1.svg").exists() && plots.join("detect-2.svg").exists());
     // the output is an observations file again
     std::fs::write(dir.path().join("labels.json"), &out).unwrap();
@@ -980,7 +986,8 @@ fn oma_refuses_the_real_chatter_record() {
     let args = ["oma", "--observations", obs.to_str().unwrap()];
     let err = fail(chatter().args(args).args(["--interference-hz", "50"]));
     assert!(
-        err.contains("chatter detection calls this record chatter") && err.contains("--allow-chatter"),
+        err.contains("chatter detection calls this record chatter")
+            && err.contains("--allow-chatter"),
         "{err}"
     );
     let out = succeed(
@@ -1002,9 +1009,10 @@ fn oma_refuses_the_real_chatter_record() {
 #[test]
 fn oma_overrides_reach_the_identification() {
     let dir = tempfile::tempdir().unwrap();
-    let signals = chatter_oma::synthetic::SyntheticRecord::single_mode(800.0, 0.02, 0.1, 10_000.0, 4.0, 2)
-        .generate()
-        .unwrap();
+    let signals =
+        chatter_oma::synthetic::SyntheticRecord::single_mode(800.0, 0.02, 0.1, 10_000.0, 4.0, 2)
+            .generate()
+            .unwrap();
     let mut csv = String::from("a\n");
     for v in &signals.data[0] {
         csv.push_str(&format!("{v:e}\n"));
@@ -1036,14 +1044,21 @@ fn oma_overrides_reach_the_identification() {
     let json: serde_json::Value = serde_json::from_str(&out).unwrap();
     let pole = &json["poles"][0];
     assert_eq!(pole["repetitions"], 4, "{pole}");
-    assert!(pole["note"].as_str().unwrap().contains("[1234.5]"), "{pole}");
+    assert!(
+        pole["note"].as_str().unwrap().contains("[1234.5]"),
+        "{pole}"
+    );
     let f = pole["frequency_hz"].as_f64().unwrap();
     assert!((f - 800.0).abs() < 0.005 * 800.0, "{pole}");
     let orders = std::fs::read_to_string(dir.path().join("d-orders.svg")).unwrap();
     assert!(orders.contains("<svg") && orders.contains("model order"));
     let err = fail(chatter().args(base).args(["--harmonics-hz", "abc"]));
     assert!(err.contains("--harmonics-hz"), "{err}");
-    let err = fail(chatter().args(base).args(["--min-order", "9", "--max-order", "3"]));
+    let err = fail(
+        chatter()
+            .args(base)
+            .args(["--min-order", "9", "--max-order", "3"]),
+    );
     assert!(err.contains("min_order"), "{err}");
     let err = fail(chatter().args(base).args(["--segments", "0"]));
     assert!(err.contains("segments"), "{err}");

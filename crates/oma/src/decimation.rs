@@ -42,7 +42,12 @@ pub fn correlation_support_lags(factor: usize) -> usize {
         return 1;
     }
     let h = taps(factor);
-    let at = |lag: usize| -> f64 { h.iter().zip(&h[lag.min(h.len())..]).map(|(a, b)| a * b).sum() };
+    let at = |lag: usize| -> f64 {
+        h.iter()
+            .zip(&h[lag.min(h.len())..])
+            .map(|(a, b)| a * b)
+            .sum()
+    };
     let peak = at(0);
     (0..=2 * HALF_WIDTH_PERIODS)
         .rev()
@@ -84,7 +89,12 @@ pub fn decimate(x: &[f64], factor: usize) -> Vec<f64> {
     }
     (half..x.len() - half)
         .step_by(factor)
-        .map(|n| h.iter().zip(&x[n - half..=n + half]).map(|(t, v)| t * v).sum())
+        .map(|n| {
+            h.iter()
+                .zip(&x[n - half..=n + half])
+                .map(|(t, v)| t * v)
+                .sum()
+        })
         .collect()
 }
 

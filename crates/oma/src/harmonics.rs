@@ -125,7 +125,8 @@ impl LineSpectrum {
     /// [`LINE_SPACING_BINS`] record bins apart.
     pub fn is_line(&self, frequency_hz: f64) -> bool {
         let step_hz = LINE_SPACING_BINS * self.record_bin_hz;
-        let at = |amp: &[f64], f: f64| amp[((f / self.grid_hz).round() as usize).min(amp.len() - 1)];
+        let at =
+            |amp: &[f64], f: f64| amp[((f / self.grid_hz).round() as usize).min(amp.len() - 1)];
         self.amplitudes.iter().any(|amp| {
             if amp.is_empty() || !(frequency_hz > 0.0 && frequency_hz < self.nyquist_hz) {
                 return false;

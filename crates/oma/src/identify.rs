@@ -401,8 +401,7 @@ impl Prepared {
         let fs = signals.sample_rate_hz;
         let with_segments = |mut p: Self| {
             let total = p.len();
-            p.segment_len =
-                ((options.segment_fraction * total as f64).round() as usize).min(total);
+            p.segment_len = ((options.segment_fraction * total as f64).round() as usize).min(total);
             p
         };
         match options.lifting {
@@ -448,10 +447,7 @@ impl Prepared {
                     classes: 1,
                     skip_lags,
                     factor,
-                    band_hz: (
-                        LOWER_EDGE_FRACTION * top,
-                        (1.0 - UPPER_EDGE_FRACTION) * top,
-                    ),
+                    band_hz: (LOWER_EDGE_FRACTION * top, (1.0 - UPPER_EDGE_FRACTION) * top),
                     lines: Some(lines),
                     segment_len: 0,
                 }))
@@ -580,7 +576,13 @@ impl Prepared {
     }
 
     /// The window rule of the module documentation for candidate `i` of `pass` at `order`.
-    fn window(&self, pass: &Pass, i: usize, order: usize, options: &IdentifyOptions) -> Result<usize> {
+    fn window(
+        &self,
+        pass: &Pass,
+        i: usize,
+        order: usize,
+        options: &IdentifyOptions,
+    ) -> Result<usize> {
         let floor = self.min_lags(order);
         self.fits(options.max_lag.unwrap_or_else(|| {
             adaptive_lags(&pass.candidates[i], pass.gap_hz(i), self.interval_s)
@@ -653,7 +655,12 @@ impl Prepared {
     }
 
     /// The admitted pole of `poles` nearest `cluster` (within 5 frequency tolerances).
-    fn matching(&self, poles: Vec<Pole>, cluster: &PoleCluster, options: &IdentifyOptions) -> Option<Pole> {
+    fn matching(
+        &self,
+        poles: Vec<Pole>,
+        cluster: &PoleCluster,
+        options: &IdentifyOptions,
+    ) -> Option<Pole> {
         let window = 5.0 * options.criteria.frequency_rel * cluster.frequency_hz;
         let target = cluster.lambda();
         poles
@@ -823,7 +830,10 @@ fn settled_order(
     let means: Vec<(usize, f64, f64)> = stats
         .iter()
         .filter(|s| s.order >= from)
-        .filter_map(|s| s.estimate.map(|e| (s.order, e.frequency_hz, e.damping_ratio)))
+        .filter_map(|s| {
+            s.estimate
+                .map(|e| (s.order, e.frequency_hz, e.damping_ratio))
+        })
         .collect();
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);

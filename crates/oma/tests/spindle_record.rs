@@ -123,7 +123,10 @@ fn issue_record_pole_over_ten_seeds() {
     let median = 0.5 * (errors[4] + errors[5]);
     eprintln!("median absolute damping error {:.2} %", 100.0 * median);
     assert!(median <= 0.08, "{errors:?}");
-    assert!(errors.iter().filter(|e| **e < 0.15).count() >= 7, "{errors:?}");
+    assert!(
+        errors.iter().filter(|e| **e < 0.15).count() >= 7,
+        "{errors:?}"
+    );
 }
 
 /// Control, seed 0: the 780 Hz line inside the mode's band is what matters. Imposing 702, 780
@@ -142,7 +145,10 @@ fn every_harmonic_in_the_band_is_needed() {
     };
     let all = run(Harmonics::Known(LINES_HZ.to_vec())).unwrap();
     let outer = run(Harmonics::Known(vec![702.0, 858.0]));
-    eprintln!("all three: {:+.1} %, 702 and 858 only: {outer:?}", 100.0 * all);
+    eprintln!(
+        "all three: {:+.1} %, 702 and 858 only: {outer:?}",
+        100.0 * all
+    );
     assert!(all.abs() < 0.2);
     assert!(outer.is_err() || outer.unwrap().abs() > 0.5);
 }

@@ -151,7 +151,10 @@ fn strong_harmonics_bias_plain_lsce_not_the_modified() {
     // poles are spectral lines of the record and are rejected (issue 16)
     let plain = run(Harmonics::None).estimate;
     eprintln!("plain identification: {plain:?}");
-    assert!(accurate(plain.frequency_hz, plain.damping_ratio), "{plain:?}");
+    assert!(
+        accurate(plain.frequency_hz, plain.damping_ratio),
+        "{plain:?}"
+    );
     let known = run(Harmonics::Known(harmonics.to_vec()));
     eprintln!(
         "known harmonics: {:?}, order {}",
