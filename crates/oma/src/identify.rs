@@ -835,14 +835,10 @@ fn settled_order(
                 .map(|e| (s.order, e.frequency_hz, e.damping_ratio))
         })
         .collect();
+    // the middle value (the upper of the two for an even count)
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
-        let m = v.len() / 2;
-        if v.len() % 2 == 0 {
-            0.5 * (v[m - 1] + v[m])
-        } else {
-            v[m]
-        }
+        v[v.len() / 2]
     };
     means
         .windows(MIN_SETTLED_ORDERS)
