@@ -9,7 +9,7 @@
 //! (`chatter_oma::identify`):
 //! - turning, or no model: modified LSCE with every spindle harmonic (rpm / 60) in the analysed
 //!   band that is a spectral line imposed (000 Eq. 19-25), after decimation when the pole lies
-//!   below 1/8 of the sample rate; poles at the band edges, poles that are spectral lines and
+//!   below 1/16 of the sample rate; poles at the band edges, poles that are spectral lines and
 //!   poles found in fewer than half the segments are rejected; the pole's `frequency_hz` is the
 //!   physical frequency;
 //! - milling model: lifting at the tooth period (from the tachometer pulses when there is a
