@@ -756,15 +756,26 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
                 .collect::<Result<Vec<Option<Pole>>>>()?;
             Ok((lags, found.into_iter().flatten().collect()))
         };
+        // an order whose window does not fit the segments has no statistics (the chosen
+        // order's must fit: it is fitted again below)
         let mut per_order = Vec::with_capacity(pass.diagram.orders.len());
         for o in &pass.diagram.orders {
-            per_order.push((o.order, at_order(o.order)?));
+            match at_order(o.order) {
+                Ok(found) => per_order.push((o.order, found)),
+                Err(OmaError::InvalidInput { .. }) => {}
+                Err(e) => return Err(e),
+            }
         }
-        let order_statistics: Vec<OrderStatistics> = per_order
+        let order_statistics: Vec<OrderStatistics> = pass
+            .diagram
+            .orders
             .iter()
-            .map(|(order, (_, poles))| OrderStatistics {
-                order: *order,
-                estimate: PoleEstimate::from_poles(poles).ok(),
+            .map(|o| OrderStatistics {
+                order: o.order,
+                estimate: per_order
+                    .iter()
+                    .find(|(n, _)| *n == o.order)
+                    .and_then(|(_, (_, poles))| PoleEstimate::from_poles(poles).ok()),
             })
             .collect();
         let order = options
