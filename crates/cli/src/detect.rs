@@ -9,16 +9,15 @@
 //! grows and bursts far beyond a random resonance (see the `chatter_oma::detection` docs). The
 //! output is an observations JSON with the input's `cuts`, then one `cuts` entry per record
 //! (`speed_rpm`, `depth_mm`, `stable`, `chatter_hz` when it chattered, `sequence` and
-//! `radial_immersion` copied) whose `note` carries the evidence in the form
-//! `detect <file>: line F Hz, V v (chatter if <= a or >= b), margin m, line/forced x dB,
-//! line/floor y dB, spindle f Hz, df d Hz`. `--plot DIR` writes `DIR/detect-N.svg`, the
+//! `radial_immersion` copied, `note` naming the file) whose `evidence` holds the numbers behind
+//! the verdict (`chatter_dynamics::CutEvidence`: line frequency, V, margin, level ratios,
+//! spindle frequency, bin width). `--plot DIR` writes `DIR/detect-N.svg`, the
 //! spectrum of record N with the harmonics and the line marked.
 
 use crate::output::emit;
 use anyhow::{Context, Result, bail};
-use chatter_dynamics::{Cut, ModalModel, Observations, Operation, SignalRecord};
+use chatter_dynamics::{Cut, CutEvidence, ModalModel, Observations, Operation, SignalRecord};
 use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
-use chatter_oma::signals::Signals;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -66,7 +65,7 @@ pub fn run(args: &DetectArgs) -> Result<()> {
                 record.file.display()
             )
         };
-        let signals = read_record(i, record).with_context(context)?;
+        let signals = crate::inputs::signal_record(i, record).with_context(context)?;
         let mut options = DetectionOptions::new(record.speed_rpm / 60.0);
         options.once_per_rev_channel = record.once_per_rev_channel.clone();
         options.interference_hz = args.interference_hz.clone();
@@ -86,26 +85,6 @@ pub fn run(args: &DetectArgs) -> Result<()> {
     emit(args.out.as_deref(), &result.to_json_string())
 }
 
-/// The record's channels: CSV at the entry's rate, WAV or MP3 at their own.
-fn read_record(i: usize, record: &SignalRecord) -> Result<Signals> {
-    let extension = record
-        .file
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    Ok(match extension.as_deref() {
-        Some("wav") => Signals::from_wav(&record.file, None)?,
-        Some("mp3") => Signals::from_mp3(&record.file)?,
-        _ => {
-            let fs = record.sample_rate_hz.with_context(|| {
-                format!(
-                    "`signals[{i}].sample_rate_hz` is missing: a CSV record needs its sample rate"
-                )
-            })?;
-            Signals::from_csv(&record.file, fs)?
-        }
-    })
-}
-
 fn cut(record: &SignalRecord, d: &Detection) -> Cut {
     let e = &d.evidence;
     let name = record.file.file_name().map_or_else(
@@ -119,19 +98,17 @@ fn cut(record: &SignalRecord, d: &Detection) -> Cut {
         chatter_hz: d.chatter_hz,
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,
-        note: Some(format!(
-            "detect {name}: line {:.2} Hz, V {:.3} (chatter if <= {} or >= {}), margin {:+.3}, \
-             line/forced {:+.1} dB, line/floor {:+.1} dB, spindle {:.3} Hz, df {:.3} Hz",
-            e.peak_hz,
-            e.line_variation,
-            e.max_line_variation,
-            e.min_burst_variation,
-            e.margin,
-            e.line_to_forced_db,
-            e.line_to_floor_db,
-            e.fundamental_hz,
-            e.resolution_hz
-        )),
+        note: Some(format!("detect {name}")),
+        evidence: Some(CutEvidence {
+            fundamental_hz: e.fundamental_hz,
+            line_hz: e.peak_hz,
+            line_variation: e.line_variation,
+            margin: e.margin,
+            line_to_forced_db: e.line_to_forced_db,
+            line_to_floor_db: e.line_to_floor_db,
+            line_to_rest_db: e.line_to_rest_db,
+            resolution_hz: e.resolution_hz,
+        }),
     }
 }
 

@@ -229,22 +229,9 @@ enum Command {
     Detect(detect::DetectArgs),
     /// Operational modal analysis of every signal of an observations file: prints observations
     /// JSON whose `poles` hold the identified dominant poles (modified LSCE with the spindle
-    /// harmonics; lifting and polyreference for a milling model).
-    Oma {
-        /// Observations file listing the `signals` (CSV or WAV).
-        #[arg(long)]
-        observations: PathBuf,
-        /// Machine model; a milling model makes the identification lifted at the tooth period.
-        #[arg(long)]
-        model: Option<PathBuf>,
-        /// Write the JSON here instead of stdout.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// SVG stabilization diagram over the first singular value of the PSD (with several
-        /// signals, one file per signal: NAME-1.svg, NAME-2.svg, ...).
-        #[arg(long)]
-        plot: Option<PathBuf>,
-    },
+    /// harmonics; lifting and polyreference for a milling model). Records that chatter
+    /// detection calls chatter are refused.
+    Oma(oma::OmaArgs),
     /// Modal fit of a measured FRF (LSCF, stabilization, residual terms): model file, JSON
     /// report on stdout, overlay plot.
     FitFrf(measured::FitFrfArgs),
@@ -407,17 +394,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Update(args) => update::run(&args, quiet),
         Command::Plan(args) => plan::run(&args, quiet),
         Command::Detect(args) => detect::run(&args),
-        Command::Oma {
-            observations,
-            model,
-            out,
-            plot,
-        } => oma::oma(
-            &observations,
-            model.as_deref(),
-            out.as_deref(),
-            plot.as_deref(),
-        ),
+        Command::Oma(args) => oma::run(&args),
         Command::FitFrf(args) => measured::fit_frf(&args),
         Command::Rcsa(args) => rcsa::rcsa(&args),
         Command::Demo { out } => commands::demo(&out, quiet),

@@ -1,48 +1,98 @@
 //! `chatter oma`: operational modal analysis of every signal listed in an observations file.
 //!
-//! Each record is read (CSV at the entry's `sample_rate_hz`, or WAV at its own rate), its
-//! `once_per_rev_channel` (if any) is taken out of the analysed channels, and the dominant pole
-//! is identified with repeated segments:
-//! - turning, or no model: modified LSCE with the spindle harmonics (rpm / 60) near the pole
-//!   that are present as spectral lines imposed (000 Eq. 19-25); the pole's `frequency_hz` is
-//!   the physical frequency;
+//! Each record is read (CSV at the entry's `sample_rate_hz`, WAV or MP3 at its own rate), its
+//! `once_per_rev_channel` (if any) gives the spindle frequency and is taken out of the analysed
+//! channels. A record that chatter detection (`chatter_oma::detection`, with the spindle
+//! frequency and any `--interference-hz`) calls chatter is refused: its dominant line is a
+//! limit cycle, not a structural pole; `--allow-chatter` identifies it anyway and says so in the
+//! pole's `note`. Then the dominant pole is identified with repeated segments
+//! (`chatter_oma::identify`):
+//! - turning, or no model: modified LSCE with every spindle harmonic (rpm / 60) in the analysed
+//!   band that is a spectral line imposed (000 Eq. 19-25), after decimation when the pole lies
+//!   below 1/16 of the sample rate; poles at the band edges, poles that are spectral lines and
+//!   poles found in fewer than half the segments are rejected; the pole's `frequency_hz` is the
+//!   physical frequency;
 //! - milling model: lifting at the tooth period (from the tachometer pulses when there is a
 //!   once-per-revolution channel, else from `speed_rpm`) and polyreference (002 Eq. 6-9); the
 //!   pole's `frequency_hz` is the principal frequency of the Floquet multiplier.
 //!
+//! Overrides: `--min-order`/`--max-order` (model orders beyond the imposed harmonics),
+//! `--segments`, `--harmonics-hz` (impose exactly these instead of the spindle lines; `none`
+//! for plain LSCE), `--decimation` (a factor; 1 for none).
+//!
 //! The result is an observations JSON with the input's `cuts` and one `poles` entry per
-//! signal, ready for the updating commands.
+//! signal, ready for the updating commands. `--plot FILE.svg` writes the stabilization diagram
+//! and `FILE-orders.svg`, the segments' mean and standard deviation of the pole's frequency and
+//! damping by model order (000 Fig. 3b/c).
 
 use crate::output::emit;
-use crate::plot::{Series, line_chart};
+use crate::plot::{ErrorBarPanel, Series, error_bar_panels, line_chart};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{ModalModel, Observations, Operation, PoleObservation, SignalRecord};
+use chatter_oma::detection::{DetectionOptions, Verdict, detect};
 use chatter_oma::identify::{LIFTED_CRITERIA, LIFTED_MAX_ORDER};
 use chatter_oma::lifting::lift_at_period;
 use chatter_oma::signals::Signals;
 use chatter_oma::spectrum::first_singular_value;
-use chatter_oma::{Harmonics, Identification, IdentifyOptions, Lifting, identify};
+use chatter_oma::{Decimation, Harmonics, Identification, IdentifyOptions, Lifting, identify};
 use plotters::style::{BLUE, RGBColor};
 use std::path::{Path, PathBuf};
 
-/// Spindle harmonics the modified LSCE may impose around the pole (000 Fig. 3 shows three).
-const SPINDLE_HARMONICS: usize = 3;
 /// Lifted channels kept per physical channel.
 const VIRTUAL_SENSORS: usize = 2;
 
+/// Arguments of `chatter oma`.
+#[derive(Debug, clap::Args)]
+pub struct OmaArgs {
+    /// Observations file listing the `signals` (CSV, WAV or MP3).
+    #[arg(long)]
+    pub observations: PathBuf,
+    /// Machine model; a milling model makes the identification lifted at the tooth period.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Write the JSON here instead of stdout.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// SVG stabilization diagram over the first singular value of the PSD, and FILE-orders.svg,
+    /// the pole by model order (with several signals, one pair per signal: NAME-1.svg, ...).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Lowest model order beyond the imposed harmonics (default 1).
+    #[arg(long)]
+    pub min_order: Option<usize>,
+    /// Highest model order beyond the imposed harmonics (default 30; 6 with lifting).
+    #[arg(long)]
+    pub max_order: Option<usize>,
+    /// Number of random segments (default 10).
+    #[arg(long)]
+    pub segments: Option<usize>,
+    /// Harmonics to impose (Hz, comma-separated) instead of the spindle lines found in the
+    /// record; `none` for plain LSCE.
+    #[arg(long, value_delimiter = ',')]
+    pub harmonics_hz: Option<Vec<String>>,
+    /// Decimation factor before LSCE (1: none; default automatic).
+    #[arg(long)]
+    pub decimation: Option<usize>,
+    /// Fundamentals of other forced combs for the chatter check (Hz), e.g. the mains 50 or 60.
+    #[arg(long, value_delimiter = ',')]
+    pub interference_hz: Vec<f64>,
+    /// Identify records that chatter detection calls chatter (flagged in the pole's `note`).
+    #[arg(long)]
+    pub allow_chatter: bool,
+}
+
 /// `chatter oma`.
-pub fn oma(
-    observations_path: &Path,
-    model_path: Option<&Path>,
-    out: Option<&Path>,
-    plot: Option<&Path>,
-) -> Result<()> {
-    let observations = crate::inputs::observations(observations_path)?;
-    let model = model_path.map(crate::inputs::model).transpose()?;
+pub fn run(args: &OmaArgs) -> Result<()> {
+    let observations = crate::inputs::observations(&args.observations)?;
+    let model = args
+        .model
+        .as_deref()
+        .map(crate::inputs::model)
+        .transpose()?;
     if observations.signals.is_empty() {
         bail!(
             "{}: no `signals` to identify; expected at least one entry with a `file`",
-            observations_path.display()
+            args.observations.display()
         );
     }
     let mut poles = Vec::with_capacity(observations.signals.len());
@@ -50,15 +100,22 @@ pub fn oma(
         let context = || {
             format!(
                 "{}: signals[{i}] ({})",
-                observations_path.display(),
+                args.observations.display(),
                 record.file.display()
             )
         };
-        let analysis = analyse(i, record, model.as_ref()).with_context(context)?;
-        if let Some(plot) = plot {
+        let analysis = analyse(i, record, model.as_ref(), args).with_context(context)?;
+        if let Some(plot) = &args.plot {
             let path = plot_path(plot, i, observations.signals.len());
             draw(&path, record, &analysis).with_context(context)?;
             eprintln!("wrote {}", path.display());
+            let orders = path.with_file_name(format!(
+                "{}-orders.svg",
+                path.file_stem()
+                    .map_or_else(|| "oma".into(), |s| s.to_string_lossy())
+            ));
+            draw_orders(&orders, record, &analysis).with_context(context)?;
+            eprintln!("wrote {}", orders.display());
         }
         poles.push(pole_observation(record, &analysis));
     }
@@ -67,7 +124,7 @@ pub fn oma(
         poles,
         signals: Vec::new(),
     };
-    emit(out, &result.to_json_string())
+    emit(args.out.as_deref(), &result.to_json_string())
 }
 
 /// One identified record.
@@ -77,21 +134,33 @@ struct Analysis {
     signals: Signals,
     lifting: Option<Lifting>,
     method: String,
+    /// The chatter verdict, when `--allow-chatter` let a chattering record through.
+    chatter_hz: Option<f64>,
 }
 
-fn analyse(i: usize, record: &SignalRecord, model: Option<&ModalModel>) -> Result<Analysis> {
-    let is_wav = record
-        .file
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("wav"));
-    let mut signals = if is_wav {
-        Signals::from_wav(&record.file, None)?
-    } else {
-        let fs = record.sample_rate_hz.with_context(|| {
-            format!("`signals[{i}].sample_rate_hz` is missing: a CSV record needs its sample rate")
-        })?;
-        Signals::from_csv(&record.file, fs)?
-    };
+/// The `--harmonics-hz` override: `none` or frequencies.
+fn harmonics_override(values: &[String]) -> Result<Harmonics> {
+    if values.len() == 1 && values[0].eq_ignore_ascii_case("none") {
+        return Ok(Harmonics::None);
+    }
+    values
+        .iter()
+        .map(|v| {
+            v.trim().parse::<f64>().with_context(|| {
+                format!("--harmonics-hz `{v}`: expected frequencies in Hz or `none`")
+            })
+        })
+        .collect::<Result<Vec<f64>>>()
+        .map(Harmonics::Known)
+}
+
+fn analyse(
+    i: usize,
+    record: &SignalRecord,
+    model: Option<&ModalModel>,
+    args: &OmaArgs,
+) -> Result<Analysis> {
+    let mut signals = crate::inputs::signal_record(i, record)?;
     let mut revolution_s = 60.0 / record.speed_rpm;
     if let Some(name) = &record.once_per_rev_channel {
         let c = signals.channel(name).with_context(|| {
@@ -104,11 +173,26 @@ fn analyse(i: usize, record: &SignalRecord, model: Option<&ModalModel>) -> Resul
         revolution_s = signals.pulse_period_s(c)?;
         signals = signals.without_channel(c)?;
     }
+    let mut detection_options = DetectionOptions::new(1.0 / revolution_s);
+    detection_options.interference_hz = args.interference_hz.clone();
+    let detection = detect(&signals, &detection_options)?;
+    let chatter_hz = match (detection.verdict, args.allow_chatter) {
+        (Verdict::Stable, _) => None,
+        (Verdict::Chatter, false) => bail!(
+            "chatter detection calls this record chatter at {:.2} Hz (line variation V {:.3}, \
+             margin {:+.3}): a chattering cut is not an OMA record, its dominant line is a limit \
+             cycle, not a structural pole; pass --allow-chatter to identify it anyway",
+            detection.evidence.peak_hz,
+            detection.evidence.line_variation,
+            detection.evidence.margin
+        ),
+        (Verdict::Chatter, true) => Some(detection.evidence.peak_hz),
+    };
     let teeth = match model.map(ModalModel::operation) {
         Some(Operation::Milling(m)) => Some(m.teeth()),
         _ => None,
     };
-    let (options, lifting, method) = match teeth {
+    let (mut options, lifting, method) = match teeth {
         Some(teeth) => {
             let lifting = Lifting {
                 period_s: revolution_s / teeth as f64,
@@ -131,19 +215,34 @@ fn analyse(i: usize, record: &SignalRecord, model: Option<&ModalModel>) -> Resul
             let options = IdentifyOptions {
                 harmonics: Harmonics::Spindle {
                     fundamental_hz: 1.0 / revolution_s,
-                    count: SPINDLE_HARMONICS,
                 },
                 ..IdentifyOptions::default()
             };
             (options, None, "modified LSCE".to_string())
         }
     };
+    if let Some(n) = args.min_order {
+        options.min_order = n;
+    }
+    if let Some(n) = args.max_order {
+        options.max_order = n;
+    }
+    if let Some(n) = args.segments {
+        options.segments = n;
+    }
+    if let Some(values) = &args.harmonics_hz {
+        options.harmonics = harmonics_override(values)?;
+    }
+    if let Some(n) = args.decimation {
+        options.decimation = Decimation::Factor(n);
+    }
     let id = identify(&signals, &options)?;
     Ok(Analysis {
         id,
         signals,
         lifting,
         method,
+        chatter_hz,
     })
 }
 
@@ -159,6 +258,24 @@ fn pole_observation(record: &SignalRecord, a: &Analysis) -> PoleObservation {
     } else {
         format!(", harmonics {:.1?} Hz imposed", a.id.harmonics_hz)
     };
+    let decimation = if a.id.decimation_factor > 1 {
+        format!(", decimated by {}", a.id.decimation_factor)
+    } else {
+        String::new()
+    };
+    let rejected = if a.id.rejected.is_empty() {
+        String::new()
+    } else {
+        let list: Vec<String> =
+            a.id.rejected
+                .iter()
+                .map(|r| format!("{:.1} Hz ({:?})", r.frequency_hz, r.reason))
+                .collect();
+        format!(", rejected {}", list.join(", "))
+    };
+    let flag = a.chatter_hz.map_or_else(String::new, |f| {
+        format!("; FLAGGED: chatter detection calls the record chatter at {f:.2} Hz")
+    });
     PoleObservation {
         speed_rpm: record.speed_rpm,
         depth_mm: record.depth_mm,
@@ -170,7 +287,7 @@ fn pole_observation(record: &SignalRecord, a: &Analysis) -> PoleObservation {
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,
         note: Some(format!(
-            "OMA of {}: {}, order {}, {} lags{harmonics}",
+            "OMA of {}: {}{decimation}, order {}, {} lags{harmonics}{rejected}{flag}",
             record.file.file_name().map_or_else(
                 || record.file.display().to_string(),
                 |n| n.to_string_lossy().into()
@@ -300,5 +417,55 @@ fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
         "model order",
         &series,
         None,
+    )
+}
+
+/// 000 Fig. 3b/c: the mean and standard deviation over the segments of the pole's frequency
+/// and damping ratio at every model order of the diagram; the order used is in the title.
+fn draw_orders(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
+    let lifted = a.lifting.is_some();
+    let stats: Vec<(f64, chatter_oma::identify::PoleEstimate)> =
+        a.id.order_statistics
+            .iter()
+            .filter_map(|s| s.estimate.map(|e| (s.order as f64, e)))
+            .collect();
+    let frequency = |e: &chatter_oma::identify::PoleEstimate| {
+        if lifted {
+            e.principal_frequency_hz
+        } else {
+            e.frequency_hz
+        }
+    };
+    let panels = [
+        ErrorBarPanel {
+            y_label: if lifted {
+                "principal frequency (Hz)".into()
+            } else {
+                "frequency (Hz)".into()
+            },
+            points: stats
+                .iter()
+                .map(|(o, e)| (*o, frequency(e), e.frequency_std_hz.unwrap_or(0.0)))
+                .collect(),
+        },
+        ErrorBarPanel {
+            y_label: "damping ratio".into(),
+            points: stats
+                .iter()
+                .map(|(o, e)| (*o, e.damping_ratio, e.damping_std.unwrap_or(0.0)))
+                .collect(),
+        },
+    ];
+    error_bar_panels(
+        path,
+        &format!(
+            "{} rpm, {} mm: pole over {} segments by model order (order used: {})",
+            record.speed_rpm,
+            record.depth_mm,
+            a.id.segment_poles.len(),
+            a.id.order
+        ),
+        "model order",
+        &panels,
     )
 }

@@ -120,3 +120,80 @@ pub fn line_chart(
     }
     crate::output::write_atomic(path, svg.as_bytes())
 }
+
+/// A panel of [`error_bar_panels`]: y label and points (x, mean, standard deviation).
+pub struct ErrorBarPanel {
+    /// Y axis label.
+    pub y_label: String,
+    /// (x, mean, standard deviation) per point.
+    pub points: Vec<(f64, f64, f64)>,
+}
+
+/// Panels stacked vertically, each a line through the means with mean +- one standard
+/// deviation as error bars, sharing the x axis; written atomically to `path`.
+pub fn error_bar_panels(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    panels: &[ErrorBarPanel],
+) -> Result<()> {
+    let xs = panels.iter().flat_map(|p| p.points.iter().map(|q| q.0));
+    let (x0, x1) = finite_range(xs).ok_or_else(|| anyhow!("nothing to plot"))?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 300 * panels.len().max(1) as u32))
+            .into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let root = root
+            .titled(title, ("sans-serif", 20))
+            .map_err(|e| anyhow!("{e}"))?;
+        for (area, panel) in root.split_evenly((panels.len(), 1)).iter().zip(panels) {
+            let pts: Vec<(f64, f64, f64)> = panel
+                .points
+                .iter()
+                .copied()
+                .filter(|p| p.0.is_finite() && p.1.is_finite() && p.2.is_finite())
+                .collect();
+            let (y0, y1) = finite_range(pts.iter().flat_map(|p| [p.1 - p.2, p.1 + p.2])).map_or(
+                (0.0, 1.0),
+                |(a, b)| {
+                    let pad = 0.05 * (b - a);
+                    (a - pad, b + pad)
+                },
+            );
+            let mut chart = ChartBuilder::on(area)
+                .margin(15)
+                .x_label_area_size(40)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0..y1)
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .configure_mesh()
+                .x_desc(x_label)
+                .y_desc(panel.y_label.as_str())
+                .draw()
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .draw_series(LineSeries::new(
+                    pts.iter().map(|p| (p.0, p.1)),
+                    BLUE.stroke_width(2),
+                ))
+                .map_err(|e| anyhow!("{e}"))?;
+            // a bar from m - s to m + s with a dot at the mean
+            chart
+                .draw_series(
+                    pts.iter()
+                        .map(|&(x, m, s)| PathElement::new(vec![(x, m - s), (x, m + s)], BLACK)),
+                )
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .draw_series(
+                    pts.iter()
+                        .map(|&(x, m, _)| Circle::new((x, m), 3, BLACK.filled())),
+                )
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    crate::output::write_atomic(path, svg.as_bytes())
+}

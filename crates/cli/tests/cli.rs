@@ -884,11 +884,16 @@ fn detect_labels_simulated_cuts() {
     assert_eq!(cuts[1]["stable"], false, "{out}");
     let f = cuts[1]["chatter_hz"].as_f64().unwrap();
     assert!((740.0..790.0).contains(&f), "{f}");
+    assert_eq!(cuts[1]["note"], "detect chatter.csv");
+    let evidence = &cuts[1]["evidence"];
     assert!(
-        cuts[1]["note"]
-            .as_str()
-            .unwrap()
-            .starts_with("detect chatter.csv: line")
+        (evidence["line_hz"].as_f64().unwrap() - f).abs() < 1e-9,
+        "{evidence}"
+    );
+    assert!(evidence["margin"].as_f64().unwrap() >= 0.0, "{evidence}");
+    assert!(
+        cuts[0]["evidence"]["margin"].as_f64().unwrap() < 0.0,
+        "{out}"
     );
     assert!(plots.join("detect-1.svg").exists() && plots.join("detect-2.svg").exists());
     // the output is an observations file again
@@ -951,4 +956,110 @@ fn zoa_lobes_include_process_damping() {
     for (got, expected) in depths.iter().flatten().zip([1.698, 0.863, 0.780, 0.821]) {
         assert!((got - expected).abs() < 2e-3, "{got} vs {expected}");
     }
+}
+
+/// `chatter oma` on the real chatter record `test255_accelY.csv` (shared data folder; slot
+/// milling at 5000 rpm, labelled chatter by its authors): with the mains frequency given,
+/// chatter detection calls it chatter and the OMA refuses it, naming the option that overrides
+/// the refusal; with `--allow-chatter` the pole is flagged in its note and is no forced line
+/// (at least 1 Hz from every multiple of 50 Hz and of the spindle frequency: before issue 16 it
+/// was 150.01 Hz). Skipped with a message when the data are absent.
+#[test]
+fn oma_refuses_the_real_chatter_record() {
+    let record = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/real/milling_chatter_record/test255_accelY.csv");
+    if !record.exists() {
+        eprintln!("skipped: {} is absent", record.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obs = dir.path().join("obs.json");
+    std::fs::write(
+        &obs,
+        format!(
+            r#"{{ "signals": [ {{ "file": {:?}, "speed_rpm": 5000, "depth_mm": 2.6,
+                 "sample_rate_hz": 10000 }} ] }}"#,
+            record.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let args = ["oma", "--observations", obs.to_str().unwrap()];
+    let err = fail(chatter().args(args).args(["--interference-hz", "50"]));
+    assert!(
+        err.contains("chatter detection calls this record chatter")
+            && err.contains("--allow-chatter"),
+        "{err}"
+    );
+    let out = succeed(
+        chatter()
+            .args(args)
+            .args(["--interference-hz", "50", "--allow-chatter"]),
+    );
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let pole = &json["poles"][0];
+    assert!(pole["note"].as_str().unwrap().contains("FLAGGED"), "{pole}");
+    let f = pole["frequency_hz"].as_f64().unwrap();
+    let off = |base: f64| (f - (f / base).round().max(1.0) * base).abs();
+    assert!(off(50.0) > 1.0 && off(5000.0 / 60.0) > 1.0, "{pole}");
+}
+
+/// `chatter oma` overrides: a model order range, the segment count, an explicit harmonic list
+/// and no decimation reach the identification (the note reports the order and the imposed
+/// harmonics); bad values are clear errors naming the option or field.
+#[test]
+fn oma_overrides_reach_the_identification() {
+    let dir = tempfile::tempdir().unwrap();
+    let signals =
+        chatter_oma::synthetic::SyntheticRecord::single_mode(800.0, 0.02, 0.1, 10_000.0, 4.0, 2)
+            .generate()
+            .unwrap();
+    let mut csv = String::from("a\n");
+    for v in &signals.data[0] {
+        csv.push_str(&format!("{v:e}\n"));
+    }
+    std::fs::write(dir.path().join("rec.csv"), csv).unwrap();
+    let obs = dir.path().join("obs.json");
+    std::fs::write(
+        &obs,
+        r#"{ "signals": [ { "file": "rec.csv", "speed_rpm": 6000, "depth_mm": 1.0,
+             "sample_rate_hz": 10000 } ] }"#,
+    )
+    .unwrap();
+    let base = ["oma", "--observations", obs.to_str().unwrap()];
+    let svg = dir.path().join("d.svg");
+    let out = succeed(chatter().args(base).args([
+        "--min-order",
+        "2",
+        "--max-order",
+        "12",
+        "--segments",
+        "4",
+        "--harmonics-hz",
+        "1234.5",
+        "--decimation",
+        "1",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let pole = &json["poles"][0];
+    assert_eq!(pole["repetitions"], 4, "{pole}");
+    assert!(
+        pole["note"].as_str().unwrap().contains("[1234.5]"),
+        "{pole}"
+    );
+    let f = pole["frequency_hz"].as_f64().unwrap();
+    assert!((f - 800.0).abs() < 0.005 * 800.0, "{pole}");
+    let orders = std::fs::read_to_string(dir.path().join("d-orders.svg")).unwrap();
+    assert!(orders.contains("<svg") && orders.contains("model order"));
+    let err = fail(chatter().args(base).args(["--harmonics-hz", "abc"]));
+    assert!(err.contains("--harmonics-hz"), "{err}");
+    let err = fail(
+        chatter()
+            .args(base)
+            .args(["--min-order", "9", "--max-order", "3"]),
+    );
+    assert!(err.contains("min_order"), "{err}");
+    let err = fail(chatter().args(base).args(["--segments", "0"]));
+    assert!(err.contains("segments"), "{err}");
 }

@@ -43,7 +43,7 @@ pub mod simulate;
 pub use error::{DynamicsError, Result};
 pub use model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
 pub use model_file::{MeasuredFrfFile, ModelFile};
-pub use observations::{Cut, Observations, PoleObservation, SignalRecord};
+pub use observations::{Cut, CutEvidence, Observations, PoleObservation, SignalRecord};
 pub use operation::{Coordinate, Milling, MillingDirection, Operation, Turning};
 pub use perturbation::{Parameter, ParameterKind, parse_parameters};
 pub use sampled::{ReceptanceMatrix, SampledReceptance};

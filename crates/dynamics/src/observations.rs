@@ -27,6 +27,35 @@ pub struct Cut {
     /// Free text.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// The numbers behind a verdict made by chatter detection (`chatter detect`); absent for
+    /// cuts labelled by hand.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evidence: Option<CutEvidence>,
+}
+
+/// Why chatter detection called a cut stable or chatter: the strongest line that is not a
+/// harmonic of the spindle frequency and the statistics of its power (criterion and thresholds
+/// in `chatter_oma::detection`).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CutEvidence {
+    /// Spindle frequency the harmonics were taken from, after refinement (Hz).
+    pub fundamental_hz: f64,
+    /// Frequency of the strongest non-synchronous line (Hz).
+    pub line_hz: f64,
+    /// Coefficient of variation V of the line's share of the power over short segments: near 0
+    /// for a limit cycle, about 1 for a resonance driven by random forces.
+    pub line_variation: f64,
+    /// Distance of V to the nearer threshold: positive for chatter.
+    pub margin: f64,
+    /// Line power over the forced (synchronous) power (dB).
+    pub line_to_forced_db: f64,
+    /// Line peak density over the median density of the non-synchronous bins (dB).
+    pub line_to_floor_db: f64,
+    /// Line power over everything else in the band (dB).
+    pub line_to_rest_db: f64,
+    /// Frequency bin width of the spectrum (Hz).
+    pub resolution_hz: f64,
 }
 
 /// A dominant closed-loop pole identified from a stable cut.
@@ -335,6 +364,7 @@ impl Observations {
                 sequence,
                 radial_immersion: None,
                 note: None,
+                evidence: None,
             });
         }
         let obs = Observations {

@@ -220,6 +220,7 @@ mod tests {
             sequence,
             radial_immersion,
             note: None,
+            evidence: None,
         }
     }
 

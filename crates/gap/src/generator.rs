@@ -698,6 +698,7 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
                     sequence,
                     radial_immersion: None,
                     note: None,
+                    evidence: None,
                 });
             }
             PlannedKind::Pole { .. } => {

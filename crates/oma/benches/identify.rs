@@ -14,7 +14,6 @@ fn bench(c: &mut Criterion) {
         max_order: 40,
         harmonics: Harmonics::Spindle {
             fundamental_hz: 7150.0 / 60.0,
-            count: 3,
         },
         ..IdentifyOptions::default()
     };

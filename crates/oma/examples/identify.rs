@@ -14,7 +14,6 @@ fn main() -> Result<(), chatter_oma::OmaError> {
     let options = IdentifyOptions {
         harmonics: Harmonics::Spindle {
             fundamental_hz: 7150.0 / 60.0,
-            count: 3,
         },
         ..IdentifyOptions::default()
     };

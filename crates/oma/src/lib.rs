@@ -17,7 +17,8 @@
 //! - [`correlation`]: unbiased correlation functions by FFT (000 Eq. 21, 002 Eq. 8).
 //! - [`lsce`]: least-squares complex exponential and the modified LSCE that imposes known
 //!   harmonics (000 Eq. 19-25).
-//! - [`harmonics`]: which spindle harmonics the modified LSCE imposes.
+//! - [`harmonics`]: which spindle harmonics the modified LSCE imposes; spectral lines.
+//! - [`decimation`]: low-pass and decimation so that the pole is not crowded next to mu = 1.
 //! - [`polyreference`]: time-domain polyreference on correlation matrices (002 Eq. 9).
 //! - [`lifting`]: lifting of time-periodic signals at their period (002 Eq. 6-7).
 //! - [`stabilization`]: stabilization diagrams over model orders.
@@ -41,6 +42,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod correlation;
+pub mod decimation;
 pub mod detection;
 pub mod error;
 pub mod harmonics;
@@ -56,4 +58,4 @@ pub mod synthetic;
 
 pub use error::{OmaError, Result};
 pub use harmonics::Harmonics;
-pub use identify::{Identification, IdentifyOptions, Lifting, identify};
+pub use identify::{Decimation, Identification, IdentifyOptions, Lifting, identify};

@@ -192,6 +192,18 @@ pub fn persistent(cluster: &PoleCluster, longest: usize) -> bool {
     4 * cluster.members.len() >= 3 * longest
 }
 
+/// The persistent clusters of `clusters`, most dominant first (step 3 of the module
+/// documentation: increasing mean decay rate -Re(lambda)).
+pub fn ranked(clusters: Vec<PoleCluster>) -> Vec<PoleCluster> {
+    let most = clusters.iter().map(|c| c.members.len()).max().unwrap_or(0);
+    let mut kept: Vec<PoleCluster> = clusters
+        .into_iter()
+        .filter(|c| persistent(c, most))
+        .collect();
+    kept.sort_by(|a, b| (-a.lambda().re).total_cmp(&(-b.lambda().re)));
+    kept
+}
+
 /// The dominant structural pole's cluster (step 3 of the module documentation).
 pub fn pick_dominant(
     diagram: &StabilizationDiagram,
@@ -199,12 +211,9 @@ pub fn pick_dominant(
     options: &PickingOptions,
 ) -> Result<PoleCluster> {
     options.validate()?;
-    let clusters = stable_clusters(diagram, known_harmonics_hz, options);
-    let most = clusters.iter().map(|c| c.members.len()).max().unwrap_or(0);
-    clusters
+    ranked(stable_clusters(diagram, known_harmonics_hz, options))
         .into_iter()
-        .filter(|c| persistent(c, most))
-        .min_by(|a, b| (-a.lambda().re).total_cmp(&(-b.lambda().re)))
+        .next()
         .ok_or_else(|| {
             OmaError::NoPole(format!(
                 "no structural pole is stable over consecutive orders among {} orders with \

@@ -186,6 +186,7 @@ mod tests {
             sequence: None,
             radial_immersion: None,
             note: None,
+            evidence: None,
         }
     }
 

@@ -433,6 +433,7 @@ impl BoundaryEnsemble {
                 sequence: None,
                 radial_immersion: None,
                 note: None,
+                evidence: None,
             };
             let w: Vec<f64> = p
                 .iter()
@@ -600,6 +601,7 @@ mod tests {
             sequence: None,
             radial_immersion: None,
             note: None,
+            evidence: None,
         };
         let kernel = CutKernel {
             sigma_depth_m: 0.02e-3,

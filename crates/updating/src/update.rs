@@ -344,6 +344,7 @@ mod tests {
                 sequence: None,
                 radial_immersion: None,
                 note: None,
+                evidence: None,
             });
         }
         let settings = UpdateSettings {

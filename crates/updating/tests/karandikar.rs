@@ -69,6 +69,7 @@ impl Machine {
             sequence: None,
             radial_immersion: None,
             note: None,
+            evidence: None,
         }
     }
 }

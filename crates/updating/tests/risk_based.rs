@@ -134,6 +134,7 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
             sequence: None,
             radial_immersion: None,
             note: None,
+            evidence: None,
         };
         cuts.push(cut);
         // 004 Section 5: the next boundaries come from the posterior given every cut so far
