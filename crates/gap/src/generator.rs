@@ -379,7 +379,11 @@ fn with_truth<T>(
         Ok(v) => return Ok(v),
         Err(e) => e,
     };
-    if let Ok(v) = f(&truth_solver_refined(model, speed_rpm, TRUTH_REFINEMENT + 1)?) {
+    if let Ok(v) = f(&truth_solver_refined(
+        model,
+        speed_rpm,
+        TRUTH_REFINEMENT + 1,
+    )?) {
         return Ok(v);
     }
     let semi = truth_solver(model, speed_rpm)?;

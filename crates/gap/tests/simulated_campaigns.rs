@@ -101,6 +101,7 @@ fn observe(nominal: &chatter_dynamics::ModalModel, scenario: &Scenario) -> Obser
                     chatter_hz: d.chatter_hz,
                     sequence: test.sequence,
                     radial_immersion: None,
+                    evidence: None,
                     note: Some(format!(
                         "V {:.2}, line {:.1} Hz; true model: |mu| {:.3} at {:.1} Hz",
                         d.evidence.line_variation, d.evidence.peak_hz, truth_mu.0, truth_mu.1
@@ -110,10 +111,7 @@ fn observe(nominal: &chatter_dynamics::ModalModel, scenario: &Scenario) -> Obser
             PlannedKind::Pole { .. } => {
                 let signals = record(&model, test.speed_rpm, test.depth_m, POLE_S, seed);
                 let options = IdentifyOptions {
-                    harmonics: Harmonics::Spindle {
-                        fundamental_hz: f0,
-                        count: 3,
-                    },
+                    harmonics: Harmonics::Spindle { fundamental_hz: f0 },
                     seed,
                     ..IdentifyOptions::default()
                 };

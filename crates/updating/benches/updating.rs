@@ -130,6 +130,7 @@ fn cut_likelihood(c: &mut Criterion) {
             chatter_hz: None,
             sequence: None,
             radial_immersion: None,
+            evidence: None,
             note: None,
         })
         .collect();
