@@ -47,9 +47,7 @@
 //! number of teeth lies on spindle harmonics and is not detected.
 //!
 //! The chatter frequency is the line's, refined by a parabola through the logarithms of the
-//! three densities around it. When the strongest line is the second or third harmonic of
-//! another line standing [`MIN_LINE_TO_FLOOR_DB`] above the floor (a limit cycle with loss of
-//! contact is not sinusoidal, and acceleration weighs harmonics by k^2), that line is taken.
+//! three densities around it.
 
 use crate::error::{OmaError, Result};
 use crate::signals::Signals;
@@ -323,7 +321,6 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             "no non-synchronous peak in the band".into(),
         ));
     };
-    let peak = fundamental_line(&psd, peak, first, floor, &synchronous);
     let e_line: f64 = (peak.saturating_sub(2)..=(peak + 2).min(psd.len() - 1))
         .filter(|&i| !synchronous(i))
         .map(|i| (psd[i] - floor).max(0.0))
@@ -409,31 +406,6 @@ fn refine_fundamental(psd: &[f64], df: f64, f0: f64, hi: f64, options: &Detectio
         })
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(f0, |(f, _)| f)
-}
-
-/// The fundamental of a line's harmonic family: a limit cycle with loss of contact is not
-/// sinusoidal, and an accelerometer weighs its k-th harmonic by k^2, so the strongest line may
-/// be 2 f_c or 3 f_c. The bin of `peak` / k (k = 3, then 2; +-2 bins) replaces it when it holds a
-/// non-synchronous local maximum that stands [`MIN_LINE_TO_FLOOR_DB`] above the floor.
-fn fundamental_line(
-    psd: &[f64],
-    peak: usize,
-    first: usize,
-    floor: f64,
-    synchronous: &dyn Fn(usize) -> bool,
-) -> usize {
-    let line = floor * 10f64.powf(MIN_LINE_TO_FLOOR_DB / 10.0);
-    for k in [3, 2] {
-        let centre = (peak as f64 / k as f64).round() as usize;
-        let candidate = (centre.saturating_sub(2).max(first + 1)..=centre + 2)
-            .filter(|&i| i < peak && !synchronous(i))
-            .filter(|&i| psd[i] >= psd[i - 1] && psd[i] >= psd[i + 1] && psd[i] >= line)
-            .max_by(|a, b| psd[*a].total_cmp(&psd[*b]));
-        if let Some(i) = candidate {
-            return i;
-        }
-    }
-    peak
 }
 
 /// Peak frequency from a parabola through the logarithms of the densities at bins i-1, i, i+1.
