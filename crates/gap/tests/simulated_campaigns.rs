@@ -7,15 +7,16 @@
 //! from a long stable record. Nothing of the diagnosis's own prediction path (the
 //! characteristic roots or the full discretization) makes the data.
 //!
-//! Turning machine of the proving ground, model right (a control). Asserted: the observation
-//! chain itself (detection labels agree with the sign of ln|mu| of the true model wherever
-//! |ln|mu|| > 0.1, i.e. away from the boundary, on >= 85 % of the cuts; chatter frequencies
-//! within 1 % of the true dominant root on >= 85 % of the chattering cuts: the limit cycle with
-//! loss of contact sits a little below the linear root, and can settle on another root), and
-//! the nominal model passing the predictive check on data it did not make (the likelihood's
-//! lapse and the check's outlier cap absorb a spurious identified pole). The verdict is printed,
-//! not asserted: on this campaign `drift` beats the nominal model by ln BF 2.2 (a wrong verdict,
-//! reported in the issue note).
+//! Turning machine of the proving ground, model right (a control), 24 cut tests at 8 speeds.
+//! Asserted: the observation chain itself (detection labels agree with the sign of ln|mu| of
+//! the true model wherever |ln|mu|| > 0.1, i.e. away from the boundary, on >= 85 % of the cuts;
+//! chatter frequencies within 1 % of the true dominant root on >= 85 % of the chattering cuts:
+//! the limit cycle with loss of contact sits a little below the linear root, and can settle on
+//! another root) and the nominal model passing the predictive check on data it did not make.
+//! The verdict is printed, not asserted: here the best class beats the nominal model by
+//! ln BF 1.3, just over the threshold ln 3, so the verdict is `parameter_error` instead of
+//! `consistent` (reported in the issue note). Pole tests are left out: on this two-mode lathe at 1200-3600 rpm the
+//! identified poles include spurious ones (1743 Hz) and ones between roots (see the issue note).
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::observations::{Cut, Observations, PoleObservation};
@@ -163,7 +164,9 @@ fn simulated_turning_control() {
     let machine = proving_machines().unwrap().remove(3);
     let (lo, hi) = machine.speed_range_rpm;
     let effect = HiddenEffect::ParameterError;
-    let mut scenario = Scenario::new(effect, 11).with_speed_range(lo, hi, 4);
+    // cut tests only: the poles the OMA identifies on this two-mode lathe at low speed are not
+    // yet reliable (see the issue note)
+    let mut scenario = Scenario::new(effect, 11).with_speed_range(lo, hi, 0);
     scenario.cuts = 24;
     scenario.speeds = 8;
     let data = observe(&machine.model, &scenario);
