@@ -28,7 +28,8 @@ pub struct NoiseModel {
     /// Probability that an observation is an outlier: an outright mislabel anywhere, or a
     /// chatter frequency or pole that belongs to something else (a nonlinear limit cycle that
     /// settled on another root, a spurious identified pole); such an observation is uniform
-    /// over its range (see [`terms`]).
+    /// over its range (the chatter frequency over one tooth-passing interval or [0, 2 f], the
+    /// pole frequency over [0, 2 f]).
     pub lapse: f64,
     /// Standard deviation of chatter frequencies as a fraction of the dominant natural frequency.
     pub chatter_std_fraction: f64,

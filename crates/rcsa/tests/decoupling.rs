@@ -37,11 +37,10 @@ fn rel(a: &Receptance, b: &Receptance) -> f64 {
     (a - b).norm() / b.norm()
 }
 
-#[test]
-fn decoupling_returns_the_spindle_within_1e_8() {
-    let f = frequency_band(50.0, 5000.0, 991).unwrap();
-    let g: Vec<Receptance> = f
-        .iter()
+/// The artifact's tip receptances coupled to the true spindle at frequencies `f` (what a tap
+/// test of the artifact measures).
+fn artifact_on_spindle(f: &[f64]) -> Vec<Receptance> {
+    f.iter()
         .map(|&f| {
             couple(
                 &free_free_receptances(&artifact(), f).unwrap(),
@@ -51,7 +50,13 @@ fn decoupling_returns_the_spindle_within_1e_8() {
             )
             .unwrap()
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn decoupling_returns_the_spindle_within_1e_8() {
+    let f = frequency_band(50.0, 5000.0, 991).unwrap();
+    let g = artifact_on_spindle(&f);
     let measured = SampledReceptance::new(f.clone(), g).unwrap();
     let Spindle::Sampled(back) = Spindle::from_artifact(&artifact(), &measured).unwrap() else {
         panic!("a sampled spindle")
@@ -69,18 +74,7 @@ fn decoupling_returns_the_spindle_within_1e_8() {
 fn an_assembly_file_with_an_artifact_gives_the_tip_frf_of_the_true_spindle() {
     let dir = tempfile::tempdir().unwrap();
     let f = frequency_band(50.0, 5000.0, 496).unwrap();
-    let g: Vec<Receptance> = f
-        .iter()
-        .map(|&f| {
-            couple(
-                &free_free_receptances(&artifact(), f).unwrap(),
-                &spindle(f),
-                &Receptance::zeros(),
-                f,
-            )
-            .unwrap()
-        })
-        .collect();
+    let g = artifact_on_spindle(&f);
     for (name, (i, j)) in [("h", (0, 0)), ("l", (0, 1)), ("p", (1, 1))] {
         let frf = Frf::new(f.clone(), g.iter().map(|g| g[(i, j)]).collect()).unwrap();
         std::fs::write(
