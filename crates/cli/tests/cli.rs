@@ -1,7 +1,7 @@
 //! The built `chatter` binary on the example files.
 #![allow(clippy::unwrap_used)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn chatter() -> Command {
@@ -749,30 +749,22 @@ fn lobes_zoa_from_measured_frf_and_clear_error_for_other_methods() {
             "measured_frf": [{"file": "xx.csv", "direction": "x"}, {"file": "xx.csv", "direction": "y"}]}"#,
     )
     .unwrap();
-    let measured = succeed(
-        chatter()
-            .args([
-                "lobes",
-                "--method",
-                "zoa",
-                "--speeds",
-                "4000:12000:5",
-                "--model",
-            ])
-            .arg(&model),
-    );
-    let modal = succeed(
-        chatter()
-            .args([
-                "lobes",
-                "--method",
-                "zoa",
-                "--speeds",
-                "4000:12000:5",
-                "--model",
-            ])
-            .arg(example("schmitz2023_milling_model.json")),
-    );
+    let zoa_lobes = |model: &Path| {
+        succeed(
+            chatter()
+                .args([
+                    "lobes",
+                    "--method",
+                    "zoa",
+                    "--speeds",
+                    "4000:12000:5",
+                    "--model",
+                ])
+                .arg(model),
+        )
+    };
+    let measured = zoa_lobes(&model);
+    let modal = zoa_lobes(&example("schmitz2023_milling_model.json"));
     let depths = |t: &str| -> Vec<f64> {
         t.lines()
             .skip(1)

@@ -375,7 +375,8 @@ fn with_truth<T>(
     speed_rpm: f64,
     f: impl Fn(&Discretization) -> chatter_stability::Result<T>,
 ) -> Result<T> {
-    let first = match f(&truth_solver(model, speed_rpm)?) {
+    let semi = truth_solver(model, speed_rpm)?;
+    let first = match f(&semi) {
         Ok(v) => return Ok(v),
         Err(e) => e,
     };
@@ -386,7 +387,6 @@ fn with_truth<T>(
     )?) {
         return Ok(v);
     }
-    let semi = truth_solver(model, speed_rpm)?;
     let full = Discretization::full().with_steps(match semi.steps {
         StepsPerDelay::Fixed(m) => m,
         StepsPerDelay::Auto => TRUTH_MIN_STEPS,

@@ -157,7 +157,7 @@ pub(crate) fn predict_pole(
 ) -> Option<PredictedPole> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
     let pole = if milling(&model) {
-        let mu = Discretization::full()
+        let mu = inference_solver(&model)
             .dominant_multiplier(&model, speed_rpm, depth_m)
             .ok()?;
         let lambda = Complex64::new(

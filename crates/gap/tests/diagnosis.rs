@@ -61,6 +61,18 @@ fn campaign(
     d
 }
 
+/// [`campaign`] on the two-direction milling machine with `class` hidden at `magnitude`.
+fn effect_campaign(
+    class: EffectClass,
+    magnitude: f64,
+    seed: u64,
+    classes: &[EffectClass],
+) -> Diagnosis {
+    let m = &proving_machines().unwrap()[0];
+    let (effect, error) = effect_at(class, magnitude, &m.model, m.speed_range_rpm).unwrap();
+    campaign(0, effect, error, seed, classes)
+}
+
 #[test]
 fn the_right_model_is_consistent() {
     let d = campaign(
@@ -77,18 +89,9 @@ fn the_right_model_is_consistent() {
 
 #[test]
 fn a_recalibration_error_is_a_parameter_error() {
-    let m = &proving_machines().unwrap()[0];
-    let (effect, error) = effect_at(
+    let d = effect_campaign(
         EffectClass::ParameterError,
         1.0,
-        &m.model,
-        m.speed_range_rpm,
-    )
-    .unwrap();
-    let d = campaign(
-        0,
-        effect,
-        error,
         22,
         &[EffectClass::ParameterError, EffectClass::ExtraMode],
     );
@@ -101,18 +104,9 @@ fn a_recalibration_error_is_a_parameter_error() {
 
 #[test]
 fn speed_dependent_modes_are_named() {
-    let m = &proving_machines().unwrap()[0];
-    let (effect, error) = effect_at(
+    let d = effect_campaign(
         EffectClass::SpeedDependentDynamics,
         2.0,
-        &m.model,
-        m.speed_range_rpm,
-    )
-    .unwrap();
-    let d = campaign(
-        0,
-        effect,
-        error,
         23,
         &[
             EffectClass::ParameterError,

@@ -183,17 +183,28 @@ pub fn closed_loop_poles(
     speed_rpm: f64,
     width_m: f64,
 ) -> Result<Vec<ClosedLoopPole>> {
+    continued_poles(model, speed_rpm, width_m)?
+        .into_iter()
+        .collect()
+}
+
+/// Every structural pole continued in the width, each with its own outcome.
+fn continued_poles(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+) -> Result<Vec<Result<ClosedLoopPole>>> {
     check_condition(speed_rpm, width_m)?;
     let ch = Characteristic::new(model, speed_rpm)?;
-    model
+    Ok(model
         .modes()
         .iter()
         .map(|m| {
             let (w, z) = (m.omega_rad_s(), m.damping_ratio());
             let start = Complex64::new(-z * w, w * (1.0 - z * z).sqrt());
-            Ok(ClosedLoopPole::new(ch.continue_pole(start, width_m)?))
+            ch.continue_pole(start, width_m).map(ClosedLoopPole::new)
         })
-        .collect()
+        .collect())
 }
 
 /// The dominant (largest real part) closed-loop pole. Delay equations have infinitely many
@@ -234,18 +245,9 @@ pub fn mode_poles(
     speed_rpm: f64,
     width_m: f64,
 ) -> Result<Vec<Option<ClosedLoopPole>>> {
-    check_condition(speed_rpm, width_m)?;
-    let ch = Characteristic::new(model, speed_rpm)?;
-    Ok(model
-        .modes()
-        .iter()
-        .map(|m| {
-            let (w, z) = (m.omega_rad_s(), m.damping_ratio());
-            let start = Complex64::new(-z * w, w * (1.0 - z * z).sqrt());
-            ch.continue_pole(start, width_m)
-                .ok()
-                .map(ClosedLoopPole::new)
-        })
+    Ok(continued_poles(model, speed_rpm, width_m)?
+        .into_iter()
+        .map(Result::ok)
         .collect())
 }
 
