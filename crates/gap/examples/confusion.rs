@@ -159,6 +159,15 @@ fn main() -> chatter_gap::Result<()> {
                 let d = diagnose(&machine.model, &data, &options, &Log(Instant::now()))?;
                 let seconds = start.elapsed().as_secs_f64();
                 times.push(seconds);
+                if std::env::args().any(|a| a == "--verbose") {
+                    eprintln!(
+                        "  nominal ln L {:.1}, nominal check {:?}\n  best check {:?}",
+                        d.nominal_log_evidence, d.nominal_check, d.predictive_check
+                    );
+                    for c in &d.classes {
+                        eprintln!("  {}: {:?}", c.name, c.parameters);
+                    }
+                }
                 let expected = effect.expected_verdict(&error);
                 let right = d.verdict.name() == expected;
                 // held-out cuts from the truth, labelled without noise

@@ -10,7 +10,7 @@
 //! | class | extra parameters | prior |
 //! |---|---|---|
 //! | `parameter_error` | none | ln s_f ~ N(0, 0.05^2), ln s_zeta ~ N(0, 0.5^2), ln g ~ N(0, 0.3^2) |
-//! | `process_damping` | C in F_d = -C b ydot / V (003) | U(0, C_max), C_max: twice the structural damping added to the mode it acts on most, at the lowest observed speed and the lowest nominal limit |
+//! | `process_damping` | C in F_d = -C b ydot / V (003) | U(0, C_max), C_max: three times the structural damping added to every mode (the least affected one sets it), at the lowest observed speed and the lowest nominal limit |
 //! | `speed_dependent_dynamics` | c in f_n(Omega) = f_n0 (1 - c Omega^2), stiffness with f_n^2 | drop c Omega_max^2 ~ U(0, 0.2) |
 //! | `extra_mode` | frequency, damping, stiffness, direction of one more mode | ln(f / f_ref) ~ U(ln 0.4, ln 2.5), ln zeta ~ U(ln 0.005, ln 0.1), ln(k / k_ref) ~ U(ln 0.3, ln 30), angle ~ U(0, pi) |
 //! | `drift` | r in cutting coefficients x (1 + r u), u the campaign position from `sequence` | N(0, 0.5^2) truncated to [-0.8, 2] |
@@ -30,8 +30,9 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// C_max: the process damping that adds this many times a mode's structural damping at the
-/// lowest observed speed and the lowest nominal limiting depth, for the mode it acts on most.
-const PROCESS_DAMPING_SPAN: f64 = 2.0;
+/// lowest observed speed and the lowest nominal limiting depth, for every mode (the one it acts
+/// on least sets the bound: which mode limits stability is not known before the fit).
+const PROCESS_DAMPING_SPAN: f64 = 3.0;
 /// Largest relative frequency drop at the highest observed speed.
 const MAX_SOFTENING: f64 = 0.2;
 
@@ -124,7 +125,7 @@ impl Nominal {
                     .filter_map(|&s| zoa_limiting_depth(&bare, s).ok())
                     .map(|p| p.depth_m)
                     .fold(f64::INFINITY, f64::min);
-                // the mode process damping acts on most, relative to its own damping
+                // every mode gets up to SPAN times its own damping: the least affected sets C_max
                 let v = PI * d * min_speed_rpm / 60.0;
                 let projector = average_normal_projector(model.operation());
                 let c = model
@@ -139,7 +140,8 @@ impl Nominal {
                         );
                         PROCESS_DAMPING_SPAN * m.damping_ratio() * v / (b_min * q)
                     })
-                    .fold(f64::INFINITY, f64::min);
+                    .filter(|c| c.is_finite())
+                    .fold(0.0, f64::max);
                 (c.is_finite() && c > 0.0).then_some(c)
             }
             None => None,
