@@ -6,7 +6,7 @@
 //! much of the nominal model's misclassification the diagnosed model closes.
 //!
 //! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1
-//! --classes drift --cuts 40 --samples 120 --steps 1]`
+//! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --verbose]`
 
 use chatter_gap::generator::{effect_at, proving_machines, true_variant};
 use chatter_gap::predict::inference_solver;
@@ -73,6 +73,14 @@ fn main() -> chatter_gap::Result<()> {
     let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
     let magnitudes: Vec<f64> = list("--magnitudes", vec![0.5, 1.0, 2.0]);
     let classes: Vec<EffectClass> = list("--classes", EffectClass::ALL.to_vec());
+    let kinds: Vec<String> = list(
+        "--cases",
+        vec!["control".into(), "effects".into(), "outside".into()],
+    );
+    let kind_of = |magnitude: &str| match magnitude {
+        "control" | "outside" => magnitude.to_string(),
+        _ => "effects".to_string(),
+    };
     let defaults = DiagnoseOptions::default();
     let options = DiagnoseOptions {
         validation: Validation::Off,
@@ -131,6 +139,7 @@ fn main() -> chatter_gap::Result<()> {
                 Recalibration::default(),
             ));
         }
+        cases.retain(|(_, magnitude, _, _)| kinds.contains(&kind_of(magnitude)));
         for (name, magnitude, effect, error) in cases {
             for seed in 0..seeds {
                 let mut scenario = Scenario::new(effect, 1000 + seed).with_speed_range(lo, hi, 4);

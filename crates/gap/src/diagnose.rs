@@ -4,7 +4,7 @@ use crate::check::{PredictiveCheck, predictive_check};
 use crate::classes::{ClassModel, EffectClass, Nominal, unavailable};
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::likelihood::{NoiseModel, terms};
+use crate::likelihood::{NoiseModel, log_sum_exp, terms};
 use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
 use crate::shrink::{Shrink, ValidationReport, shrink};
@@ -166,7 +166,7 @@ impl DiagnosisObserver for Quiet {}
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
     /// The nominal model explains the data up to the noise: it passes the predictive check and
-    /// no class beats it by the required Bayes factor.
+    /// the tried classes' mean evidence does not beat it by the required Bayes factor.
     Consistent,
     /// The best class passes the predictive check.
     Class(EffectClass),
@@ -310,6 +310,7 @@ pub(crate) fn fit<'a>(
     seed: u64,
 ) -> Result<Fitted<'a>> {
     let model = ClassModel::new(class, nominal)?;
+    let samples = (samples as f64 * class.population_factor()).round() as usize;
     let count = FailureCount::default();
     let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta, &count);
     let run =
@@ -401,6 +402,10 @@ pub struct Diagnosis {
     /// ln p(D | nominal model): the likelihood of the nominal model, a class without free
     /// parameters.
     pub nominal_log_evidence: f64,
+    /// ln of the tried classes' mean evidence: the evidence of the alternative to the nominal
+    /// model. `consistent` needs the nominal model to pass its check and this to beat
+    /// `nominal_log_evidence` by less than the required ln Bayes factor.
+    pub alternative_log_evidence: f64,
     /// The predictive check of the nominal model itself (the `consistent` verdict needs it).
     pub nominal_check: PredictiveCheck,
     #[serde(skip)]
@@ -544,8 +549,12 @@ pub fn diagnose(
         options.check_level,
         options.seed,
     );
+    // the alternative "the nominal model is wrong in one of the tried ways" is the classes'
+    // average evidence (equal prior probabilities): naming the best class after the fact would
+    // pick the luckiest of several noisy evidences and raise false alarms
+    let alternative_log_evidence = log_sum_exp(&evidences) - (evidences.len() as f64).ln();
     let consistent = nominal_check.passed
-        && evidences[most_probable] - nominal_log_evidence < options.min_log_bayes_factor;
+        && alternative_log_evidence - nominal_log_evidence < options.min_log_bayes_factor;
     let verdict = if consistent {
         Verdict::Consistent
     } else if check.passed {
@@ -610,6 +619,7 @@ pub fn diagnose(
         residuals: residual_pair,
         notes,
         nominal_log_evidence,
+        alternative_log_evidence,
         nominal_check,
         nominal: nominal_variant,
         diagnosed,

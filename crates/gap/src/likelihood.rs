@@ -134,7 +134,8 @@ fn ln_wrapped_normal(r: f64, s: f64, fold: f64) -> f64 {
     }
 }
 
-fn log_sum_exp(x: &[f64]) -> f64 {
+/// ln sum_i e^{x_i}, shifted by the maximum so that no term overflows.
+pub(crate) fn log_sum_exp(x: &[f64]) -> f64 {
     let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if !m.is_finite() {
         return m;
