@@ -29,6 +29,7 @@ pub fn check(model: &Path, observations: Option<&Path>) -> Result<()> {
     );
     if let Some(o) = observations {
         let obs = inputs::observations(o)?;
+        validate::observations_match(&m, &obs, o, model)?;
         let _ = write!(
             line,
             "; {}: {} cuts, {} poles, {} signals",

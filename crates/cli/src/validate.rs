@@ -54,7 +54,11 @@ pub fn option(flag: &str, value: f64, range: &Plausible) -> Result<f64> {
     if range.contains(value) {
         Ok(value)
     } else {
-        bail!("{flag} {}: expected {}", as_typed(flag, value), range.expected())
+        bail!(
+            "{flag} {}: expected {}",
+            as_typed(flag, value),
+            range.expected()
+        )
     }
 }
 

@@ -185,12 +185,18 @@ pub const RADIAL_IMMERSION: Plausible = open_closed(0.0, 1.0, "a fraction of the
 /// A number as a user would write it: integers without a decimal point, other values in the
 /// shortest form that reads back to the same number (`1e300`, `0.05`, `-750`).
 pub fn written(value: f64) -> String {
-    if value.is_finite() && value.fract() == 0.0 && value.abs() < 1e16 {
-        format!("{value:.0}")
-    } else if value == f64::MAX {
-        "inf".into()
+    if value == f64::MAX {
+        return "inf".into();
+    }
+    if !(value.is_finite() && value.fract() == 0.0 && value.abs() < 1e16) {
+        return format!("{value:?}");
+    }
+    let plain = format!("{value:.0}");
+    let scientific = format!("{value:e}");
+    if value.abs() >= 1e6 && scientific.len() < plain.len() {
+        scientific
     } else {
-        format!("{value:?}")
+        plain
     }
 }
 
@@ -206,6 +212,8 @@ mod tests {
             (0.05, "0.05"),
             (1e-6, "1e-6"),
             (0.0, "0"),
+            (1e13, "1e13"),
+            (1234567.0, "1234567"),
             (f64::NAN, "NaN"),
         ] {
             assert_eq!(written(v), s);

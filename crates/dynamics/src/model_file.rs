@@ -333,10 +333,12 @@ impl OperationFile {
         if let Some(t) = self.teeth
             && !(1..=limits::MAX_TEETH).contains(&t)
         {
-            return Err(DynamicsError::value(
+            return Err(DynamicsError::invalid(
                 "operation.teeth",
-                t as f64,
-                format!("a number of teeth from 1 to {}", limits::MAX_TEETH),
+                format!(
+                    "{t}: expected a number of teeth from 1 to {}",
+                    limits::MAX_TEETH
+                ),
             ));
         }
         if let Some(r) = self.radial_immersion {
