@@ -161,10 +161,10 @@ pub fn bands(req: &BandRequest) -> Result<()> {
             );
         }
     }
-    if req.kind != BandKind::Geometric || req.method.is_some_and(|m| m != Method::Zoa) {
-        if let Some(d) = req.method.unwrap_or(Method::Fdm).discretization() {
-            validate::work_size(&model, d, &speeds, "--speeds")?;
-        }
+    if let Some(d) = req.method.unwrap_or(Method::Fdm).discretization()
+        && (req.kind != BandKind::Geometric || req.method.is_some())
+    {
+        validate::work_size(&model, d, &speeds, "--speeds")?;
     }
     match req.kind {
         BandKind::Geometric => geometric(req, &model, &speeds, obs.as_ref()),

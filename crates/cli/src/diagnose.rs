@@ -70,6 +70,9 @@ impl DiagnosisObserver for Progress {
     }
 }
 
+/// Files of a result: name and content.
+pub type Files = Vec<(String, Vec<u8>)>;
+
 /// What `--out` of `chatter diagnose` may hold.
 pub const FILES: [&str; 5] = [
     "diagnosis.json",
@@ -102,7 +105,7 @@ pub fn run(r: &DiagnoseRequest, folds_given: bool) -> Result<()> {
 /// The diagnosis, its report JSON and, with `out`, the files `diagnosis.json`,
 /// `diagnosed_model.json` (and `diagnosed_effects.json`), `lobes.svg` and `residuals.svg` (name
 /// and content; the caller writes them).
-pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String, Vec<(String, Vec<u8>)>)> {
+pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String, Files)> {
     let model = inputs::model(r.model)?;
     let observations = inputs::observations(r.observations)?;
     report_of(&model, &observations, r)
@@ -114,7 +117,7 @@ pub fn report_of(
     model: &chatter_dynamics::ModalModel,
     observations: &chatter_dynamics::Observations,
     r: &DiagnoseRequest,
-) -> Result<(Diagnosis, String, Vec<(String, Vec<u8>)>)> {
+) -> Result<(Diagnosis, String, Files)> {
     crate::validate::observations_match(model, observations, r.observations, r.model)?;
     crate::validate::observation_work_size(model, observations, r.observations)?;
     let entries = observations.cuts.len() + observations.poles.len();
@@ -178,7 +181,7 @@ pub fn report_of(
         nominal_check: &d.nominal_check,
         notes: &d.notes,
     };
-    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut files: Files = Vec::new();
     if r.out.is_some() {
         let full = serde_json::to_string_pretty(&diagnosis)?;
         files.push(("diagnosis.json".into(), full.into_bytes()));

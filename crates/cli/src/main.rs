@@ -1,6 +1,8 @@
 //! `chatter`: stability lobes, multipliers, uncertainty bands and the demo, over the
 //! chatter-* crates. Thin by design: parse, call, write.
 
+#![cfg_attr(test, allow(clippy::unwrap_used))]
+
 mod bands;
 mod commands;
 mod detect;

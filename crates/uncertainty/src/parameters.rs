@@ -84,9 +84,9 @@ impl ParameterDistribution {
         // a covariance is symmetric: an asymmetric matrix is a typo, not a distribution (the
         // Cholesky factor would silently read one triangle only); relative tolerance 1e-9 for
         // values printed with ten significant digits
-        for i in 0..d {
-            for j in 0..i {
-                let (a, b) = (covariance[i][j], covariance[j][i]);
+        for (i, row) in covariance.iter().enumerate() {
+            for (j, column) in covariance.iter().enumerate().take(i) {
+                let (a, b) = (row[j], column[i]);
                 if !(a.is_finite() && b.is_finite()) || (a - b).abs() > 1e-9 * a.abs().max(b.abs())
                 {
                     return Err(invalid(
