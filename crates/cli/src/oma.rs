@@ -83,6 +83,17 @@ pub struct OmaArgs {
 
 /// `chatter oma`.
 pub fn run(args: &OmaArgs) -> Result<()> {
+    use crate::validate::count;
+    for (flag, value, max, what) in [
+        ("--segments", args.segments, 200, "random segments"),
+        ("--min-order", args.min_order, 200, "model orders"),
+        ("--max-order", args.max_order, 200, "model orders"),
+        ("--decimation", args.decimation, 1000, "a decimation factor"),
+    ] {
+        if let Some(n) = value {
+            count(flag, n, 1, max, what)?;
+        }
+    }
     crate::output::check_optional_file("--out", args.out.as_deref())?;
     crate::output::check_optional_file("--plot", args.plot.as_deref())?;
     let observations = crate::inputs::observations(&args.observations)?;

@@ -496,6 +496,19 @@ fn cases(f: &Files) -> Vec<Case> {
             r#"{{"signals": [{{"file": "{signal}", "speed_rpm": 7000, "depth_mm": 1, "sample_rate_hz": 10000}}]}}"#
         ),
     );
+    for (flag, value) in [
+        ("--segments", "100000000"),
+        ("--segments", "0"),
+        ("--max-order", "100000"),
+        ("--min-order", "0"),
+        ("--decimation", "0"),
+    ] {
+        c.push(case(
+            "option range",
+            strings(&["oma", "--observations", &signal_obs, flag, value]),
+            &[&format!("{flag} {value}")],
+        ));
+    }
     for command in ["oma", "detect"] {
         c.push(case(
             "mismatch",
