@@ -49,14 +49,26 @@ impl Bar {
     /// Set the position.
     pub fn set(&self, done: usize) {
         self.bar.set_position(done as u64);
+        self.log_line("");
+    }
+
+    /// Progress inside the current step (e.g. a sampler's stage), shown beside the message.
+    pub fn detail(&self, text: &str) {
+        self.bar.set_message(format!("{} ({text})", self.message));
+        self.log_line(&format!(" ({text})"));
+    }
+
+    /// A line for logs, at most every [`LOG_EVERY`], when stderr is not a terminal.
+    fn log_line(&self, detail: &str) {
         let Some(log) = &self.log else { return };
         let Ok(mut last) = log.lock() else { return };
         if last.elapsed() >= LOG_EVERY {
             *last = Instant::now();
-            let total = self.bar.length().unwrap_or(0);
             eprintln!(
-                "{}: {done}/{total}, {:.0} s elapsed, about {:.0} s left",
+                "{}: {}/{}{detail}, {:.0} s elapsed, about {:.0} s left",
                 self.message,
+                self.bar.position(),
+                self.bar.length().unwrap_or(0),
                 self.bar.elapsed().as_secs_f64(),
                 self.bar.eta().as_secs_f64()
             );

@@ -59,7 +59,17 @@ pub struct UpdateArgs {
 /// Progress: one step per model class.
 struct ClassProgress(Bar);
 
-impl SamplerObserver for ClassProgress {}
+impl SamplerObserver for ClassProgress {
+    fn stage(&self, index: usize, beta: f64, acceptance: f64) {
+        self.0.detail(&format!(
+            "stage {index}, beta {beta:.3}, acceptance {acceptance:.2}"
+        ));
+    }
+    fn chain_progress(&self, chain: usize, done: usize, total: usize) {
+        self.0
+            .detail(&format!("chain {chain}: {done}/{total} samples"));
+    }
+}
 
 impl ClassObserver for ClassProgress {
     fn class_started(&self, index: usize, _total: usize, _alpha: f64) {
