@@ -428,8 +428,8 @@ fn cases(f: &Files) -> Vec<Case> {
         ),
         (
             "c-depth.csv",
-            "speed_rpm,depth_mm,stable,chatter_hz\n7000,-2,true,\n",
-            "-2",
+            "speed_rpm,depth_mm,stable,chatter_hz\n7000,1,true,\n7000,-2,true,\n",
+            "line 3, cuts[1].depth_mm`: -2",
         ),
     ] {
         let path = f.write(name, text);

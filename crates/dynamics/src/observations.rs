@@ -180,6 +180,34 @@ impl PoleObservation {
     }
 }
 
+/// A validation error of a cuts table with the CSV line (header on line 1) before the entry:
+/// `line 3, cuts[1].depth_mm`.
+fn csv_line(error: DynamicsError) -> DynamicsError {
+    let line = |field: &str| {
+        field
+            .strip_prefix("cuts[")
+            .and_then(|rest| rest.split(']').next())
+            .and_then(|i| i.parse::<usize>().ok())
+            .map_or_else(|| field.to_string(), |i| format!("line {}, {field}", i + 2))
+    };
+    match error {
+        DynamicsError::InvalidValue {
+            field,
+            value,
+            expected,
+        } => DynamicsError::InvalidValue {
+            field: line(&field),
+            value,
+            expected,
+        },
+        DynamicsError::Invalid { field, message } => DynamicsError::Invalid {
+            field: line(&field),
+            message,
+        },
+        other => other,
+    }
+}
+
 impl Observations {
     /// Check every entry; an observations set with no entries at all is an error, and so is a
     /// pole given twice (it would count twice in the likelihood).
@@ -417,7 +445,7 @@ impl Observations {
             cuts,
             ..Default::default()
         };
-        obs.validate().map_err(|e| e.in_file(origin))?;
+        obs.validate().map_err(|e| csv_line(e).in_file(origin))?;
         Ok(obs)
     }
 
