@@ -455,3 +455,40 @@ impl Observations {
         serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::examples;
+
+    #[test]
+    fn observations_are_checked_against_the_operation_of_the_model() {
+        let turning = examples::ahmadi_2022_turning_observations();
+        let milling = examples::ebrahimi_2025_milling_observations();
+        assert!(
+            turning
+                .check_against(&examples::ahmadi_2022_turning())
+                .is_ok()
+        );
+        assert!(
+            milling
+                .check_against(&examples::ebrahimi_2025_milling())
+                .is_ok()
+        );
+        // 2473 Hz at 7150 rpm is far above half the tooth-passing frequency of 4 teeth (238 Hz)
+        let e = turning
+            .check_against(&examples::schmitz_2023_milling())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("poles[0].frequency_hz") && e.contains("2473"),
+            "{e}"
+        );
+        let mut with_immersion = milling.clone();
+        with_immersion.cuts[0].radial_immersion = Some(0.5);
+        let e = with_immersion
+            .check_against(&examples::ahmadi_2022_turning())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("cuts[0].radial_immersion"), "{e}");
+    }
+}
