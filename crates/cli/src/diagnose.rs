@@ -120,11 +120,28 @@ pub fn report_of(
 ) -> Result<(Diagnosis, String, Files)> {
     crate::validate::observations_match(model, observations, r.observations, r.model)?;
     crate::validate::observation_work_size(model, observations, r.observations)?;
-    let entries = observations.cuts.len() + observations.poles.len();
-    if r.validation != ValidationArg::Off && entries > 0 && r.folds > entries {
+    // k-fold splits the entries, speed bands split the distinct speeds
+    let speeds = observations
+        .cuts
+        .iter()
+        .map(|c| c.speed_rpm)
+        .chain(observations.poles.iter().map(|p| p.speed_rpm));
+    let (available, what) = match r.validation {
+        ValidationArg::Kfold => (
+            observations.cuts.len() + observations.poles.len(),
+            "cuts and poles",
+        ),
+        ValidationArg::SpeedBands => {
+            let mut distinct: Vec<f64> = speeds.collect();
+            distinct.sort_by(f64::total_cmp);
+            distinct.dedup();
+            (distinct.len(), "distinct speeds")
+        }
+        ValidationArg::Off => (usize::MAX, ""),
+    };
+    if available > 0 && r.folds > available {
         bail!(
-            "--folds {}: {} holds {entries} cuts and poles; expected at most one fold per \
-             observation",
+            "--folds {}: {} holds {available} {what}; expected at most one fold per entry",
             r.folds,
             r.observations.display()
         );

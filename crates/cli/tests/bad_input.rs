@@ -834,6 +834,10 @@ fn cases(f: &Files) -> Vec<Case> {
     ));
     for (args, expect) in [
         (vec!["--folds", "100"], "--folds 100"),
+        (
+            vec!["--validation", "speed-bands", "--folds", "4"],
+            "3 distinct speeds",
+        ),
         (vec!["--samples", "5"], "--samples 5"),
     ] {
         let mut a = strings(&[
