@@ -6,11 +6,11 @@
 //! echoes the value as written, instead of a NaN lobe or an allocation of terabytes downstream.
 //! The ranges are deliberately wide: they catch nonsense, not unusual machines.
 //!
-//! Sources of the bounds: spindle speeds of machine tools reach about 2e5 rpm (air-bearing
-//! micro-milling spindles), structural modes of tool, holder, spindle and workpiece lie within
-//! about 1 Hz to 50 kHz, specific cutting forces of metals lie within about 100 to 10 000 N/mm^2
-//! (Altintas, *Manufacturing Automation*, 2nd ed., Table 2.1 and Ch. 3), and milling cutters have
-//! 1 to about 100 teeth (large face mills and slitting saws).
+//! The bounds are judgement, not a table: orders of magnitude around what machine tools do
+//! (spindles up to some 2e5 rpm, structural modes of tool, holder, spindle and workpiece from
+//! about 1 Hz to tens of kHz, specific cutting forces of metals of hundreds to thousands of
+//! N/mm^2, milling cutters with 1 to about 100 teeth), widened so that no real machine is
+//! refused.
 //!
 //! ```
 //! use chatter_dynamics::limits::{FREQUENCY_HZ, written};
