@@ -2,8 +2,9 @@
 //! probability-of-stability maps around the lobes.
 
 use crate::commands::{Method, compute_lobes, markers};
-use crate::output::{emit, write_atomic};
+use crate::output::{self, emit, write_atomic};
 use crate::plot::{Series, line_chart};
+use crate::validate;
 use crate::{inputs, progress::Bar};
 use anyhow::{Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
@@ -39,16 +40,16 @@ pub struct BandRequest<'a> {
     pub speeds: Option<&'a str>,
     /// Depths MIN:MAX:N (perturbation grid, Monte Carlo map).
     pub depths: Option<&'a str>,
-    /// Type B offsets (rpm, mm).
-    pub offsets: (f64, f64),
+    /// Type B offsets (rpm, mm) when given (default 100 rpm, 0.2 mm).
+    pub offsets: (Option<f64>, Option<f64>),
     /// Posterior folder.
     pub posterior: Option<&'a Path>,
     /// Covariance file.
     pub covariance: Option<&'a Path>,
-    /// Monte Carlo samples.
-    pub samples: usize,
-    /// Seed of the Monte Carlo draws.
-    pub seed: u64,
+    /// Monte Carlo samples when given (default 500).
+    pub samples: Option<usize>,
+    /// Seed of the Monte Carlo draws when given (default 0).
+    pub seed: Option<u64>,
     /// Observed cuts.
     pub observations: Option<&'a Path>,
     /// CSV destination (stdout when absent).
@@ -61,14 +62,110 @@ pub struct BandRequest<'a> {
     pub quiet: bool,
 }
 
+/// Default Type B speed offset (seed 001).
+const OFFSET_RPM: f64 = 100.0;
+/// Default Type B depth offset (seed 001).
+const OFFSET_MM: f64 = 0.2;
+/// Default Monte Carlo samples.
+const SAMPLES: usize = 500;
+/// Most Monte Carlo samples.
+const MAX_SAMPLES: usize = 100_000;
+
+/// The kind's name as the user types it.
+fn kind_name(kind: BandKind) -> String {
+    use clap::ValueEnum;
+    kind.to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
+}
+
+/// Options the kind uses are in range and options it ignores are absent; outputs writable.
+fn check_options(req: &BandRequest) -> Result<()> {
+    let context = format!("with --kind {}", kind_name(req.kind));
+    let geometric = req.kind == BandKind::Geometric;
+    let montecarlo = req.kind == BandKind::Montecarlo;
+    for (given, flag, used_by) in [
+        (req.offsets.0.is_some(), "--offset-rpm", "--kind geometric"),
+        (req.offsets.1.is_some(), "--offset-mm", "--kind geometric"),
+    ] {
+        validate::unused(given && !geometric, flag, &context, used_by)?;
+    }
+    for (given, flag) in [
+        (req.posterior.is_some(), "--posterior"),
+        (req.covariance.is_some(), "--covariance"),
+    ] {
+        validate::unused(
+            given && geometric,
+            flag,
+            &context,
+            "--kind perturbation and montecarlo",
+        )?;
+    }
+    for (given, flag) in [
+        (req.samples.is_some(), "--samples"),
+        (req.seed.is_some(), "--seed"),
+        (req.map_out.is_some(), "--map-out"),
+    ] {
+        validate::unused(given && !montecarlo, flag, &context, "--kind montecarlo")?;
+    }
+    validate::unused(
+        req.depths.is_some() && (geometric || (montecarlo && req.map_out.is_none())),
+        "--depths",
+        &if montecarlo {
+            format!("{context} without --map-out")
+        } else {
+            context.clone()
+        },
+        "the perturbation grid and the Monte Carlo map (--map-out)",
+    )?;
+    validate::unused(
+        req.observations.is_some() && req.plot.is_none(),
+        "--observations",
+        "without --plot",
+        "drawing the observed cuts on the plot",
+    )?;
+    if let Some(v) = req.offsets.0 {
+        validate::option("--offset-rpm", v, &validate::OFFSET_RPM)?;
+    }
+    if let Some(v) = req.offsets.1 {
+        validate::option("--offset-mm", v, &validate::OFFSET_MM)?;
+    }
+    if let Some(n) = req.samples {
+        validate::count("--samples", n, 2, MAX_SAMPLES, "Monte Carlo samples")?;
+    }
+    if let Some(spec) = req.depths {
+        validate::grid("--depths", spec, &validate::DEPTH_GRID_MM)?;
+    }
+    output::check_optional_file("--out", req.out)?;
+    output::check_optional_file("--map-out", req.map_out)?;
+    output::check_optional_file("--plot", req.plot)
+}
+
 /// `chatter bands`.
 pub fn bands(req: &BandRequest) -> Result<()> {
+    check_options(req)?;
+    let speeds = req.speeds.map(validate::speeds).transpose()?;
     let model = inputs::model(req.model)?;
     let obs = req.observations.map(inputs::observations).transpose()?;
-    let speeds = match req.speeds {
-        Some(s) => inputs::speeds(s)?,
+    let speeds = match speeds {
+        Some(s) => s,
         None => chatter_stability::boundary::default_speeds_rpm(&model),
     };
+    if let Some(offset) = req.offsets.0 {
+        let span = speeds.last().unwrap_or(&0.0) - speeds.first().unwrap_or(&0.0);
+        if offset > span {
+            bail!(
+                "--offset-rpm {}: larger than the speed range ({} rpm); expected an offset \
+                 within the speeds of the lobes",
+                validate::as_typed("--offset-rpm", offset),
+                chatter_dynamics::limits::written(span)
+            );
+        }
+    }
+    if let Some(d) = req.method.unwrap_or(Method::Fdm).discretization()
+        && (req.kind != BandKind::Geometric || req.method.is_some())
+    {
+        validate::work_size(&model, d, &speeds, "--speeds")?;
+    }
     match req.kind {
         BandKind::Geometric => geometric(req, &model, &speeds, obs.as_ref()),
         BandKind::Perturbation => perturbation(req, &model, &speeds, obs.as_ref()),
@@ -92,7 +189,11 @@ fn geometric(
 ) -> Result<()> {
     let lobes = compute_lobes(model, req.method.unwrap_or(Method::Zoa), speeds, req.quiet)?;
     let curve = finite_curve(&lobes);
-    let bands = type_b_offsets(&curve, TypeBOffsets::new(req.offsets.0, req.offsets.1)?)?;
+    let offsets = TypeBOffsets::new(
+        req.offsets.0.unwrap_or(OFFSET_RPM),
+        req.offsets.1.unwrap_or(OFFSET_MM),
+    )?;
+    let bands = type_b_offsets(&curve, offsets)?;
     let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance\n");
     for p in &bands.points {
         let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
@@ -152,15 +253,18 @@ pub fn band_series(
     ]
 }
 
-fn distribution(req: &BandRequest) -> Result<ParameterDistribution> {
+fn distribution(req: &BandRequest, model: &ModalModel) -> Result<ParameterDistribution> {
     Ok(match (req.posterior, req.covariance) {
-        (Some(dir), None) => ParameterDistribution::from_posterior_dir(dir)?,
+        (Some(dir), None) => {
+            validate::posterior_matches(model, dir)?;
+            ParameterDistribution::from_posterior_dir(dir)?
+        }
         (None, Some(file)) => ParameterDistribution::from_covariance_file(file)?,
         (Some(_), Some(_)) => bail!("give either --posterior DIR or --covariance FILE, not both"),
         (None, None) => bail!(
-            "--kind {:?} needs a parameter distribution: --posterior DIR (from `chatter update`) \
+            "--kind {} needs a parameter distribution: --posterior DIR (from `chatter update`) \
              or --covariance FILE ({{\"parameter_names\": [...], \"covariance\": [[...]]}})",
-            req.kind
+            kind_name(req.kind)
         ),
     })
 }
@@ -168,14 +272,14 @@ fn distribution(req: &BandRequest) -> Result<ParameterDistribution> {
 fn discretization(req: &BandRequest) -> Result<chatter_stability::monodromy::Discretization> {
     match req.method.unwrap_or(Method::Fdm).discretization() {
         Some(d) => Ok(d),
-        None => bail!("--kind {:?} needs --method fdm or sdm", req.kind),
+        None => bail!("--kind {} needs --method fdm or sdm", kind_name(req.kind)),
     }
 }
 
 /// Depth grid: `--depths` or 0 to 1.5 times the deepest finite limit, 100 points.
 fn depth_grid(req: &BandRequest, reference: &[LobePoint]) -> Result<Vec<f64>> {
     if let Some(spec) = req.depths {
-        return inputs::grid("--depths", spec, 0.0);
+        return validate::grid("--depths", spec, &validate::DEPTH_GRID_MM);
     }
     let top = reference
         .iter()
@@ -194,7 +298,7 @@ fn perturbation(
     speeds: &[f64],
     obs: Option<&Observations>,
 ) -> Result<()> {
-    let dist = distribution(req)?;
+    let dist = distribution(req, model)?;
     let method = discretization(req)?;
     let mean_model = dist.mean_model(model)?;
     let mean_lobes = compute_lobes(&mean_model, req.method.unwrap_or(Method::Fdm), speeds, true)?;
@@ -269,12 +373,9 @@ fn montecarlo(
     speeds: &[f64],
     obs: Option<&Observations>,
 ) -> Result<()> {
-    if req.samples < 2 {
-        bail!("--samples {}: at least 2 samples expected", req.samples);
-    }
-    let dist = distribution(req)?;
+    let dist = distribution(req, model)?;
     let method = discretization(req)?;
-    let thetas = dist.draws(req.samples, req.seed)?;
+    let thetas = dist.draws(req.samples.unwrap_or(SAMPLES), req.seed.unwrap_or(0))?;
     let bar = Bar::new(thetas.len() as u64, "Monte Carlo samples", req.quiet);
     let sampled = sample_boundaries(
         &method,

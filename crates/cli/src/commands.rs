@@ -1,7 +1,8 @@
 //! One function per subcommand: parse inputs, call the libraries, write results.
 
-use crate::output::{emit, write_atomic};
-use crate::plot::{Markers, Series, line_chart};
+use crate::output::{self, Folder, emit, write_atomic};
+use crate::plot::{Markers, Series, line_chart, line_chart_svg};
+use crate::validate;
 use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
@@ -28,6 +29,7 @@ pub fn check(model: &Path, observations: Option<&Path>) -> Result<()> {
     );
     if let Some(o) = observations {
         let obs = inputs::observations(o)?;
+        validate::observations_match(&m, &obs, o, model)?;
         let _ = write!(
             line,
             "; {}: {} cuts, {} poles, {} signals",
@@ -129,6 +131,9 @@ pub fn compute_lobes(
             &ZeroOrderOptions::unbounded(),
         )?),
         Method::Fdm | Method::Sdm => {
+            if let Some(d) = method.discretization() {
+                validate::work_size(model, d, speeds, "--speeds")?;
+            }
             let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
             let lobes = method
                 .prepare(model, &BoundaryOptions::default())?
@@ -178,7 +183,7 @@ fn load_and_compute(
     }
     let model = inputs::model(model_path)?;
     let speeds = match speeds {
-        Some(s) => inputs::speeds(s)?,
+        Some(s) => validate::speeds(s)?,
         None => chatter_stability::boundary::default_speeds_rpm(&model),
     };
     Ok((obs, compute_lobes(&model, method, &speeds, quiet)?))
@@ -194,6 +199,7 @@ pub fn lobes(
     plot: Option<&Path>,
     quiet: bool,
 ) -> Result<()> {
+    check_outputs(out, plot, observations)?;
     let (obs, lobes) = load_and_compute(model_path, method, speeds, observations, quiet)?;
     emit(out, &lobes_csv(&lobes))?;
     if let Some(p) = plot {
@@ -215,12 +221,30 @@ pub fn lobes(
     Ok(())
 }
 
+/// `--out` and `--plot` writable, and `--observations` only with `--plot` (they are drawn, not
+/// used in the numbers).
+pub fn check_outputs(
+    out: Option<&Path>,
+    plot: Option<&Path>,
+    observations: Option<&Path>,
+) -> Result<()> {
+    output::check_optional_file("--out", out)?;
+    output::check_optional_file("--plot", plot)?;
+    validate::unused(
+        observations.is_some() && plot.is_none(),
+        "--observations",
+        "without --plot",
+        "drawing the observed cuts on the plot",
+    )
+}
+
 /// `chatter multiplier`.
 pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Method) -> Result<()> {
     let model = inputs::model(model_path)?;
     let Some(solver) = method.discretization() else {
         bail!("--method zoa gives limiting depths, not multipliers; use fdm or sdm");
     };
+    validate::work_size(&model, solver, &[speed_rpm], "--speed-rpm")?;
     let (mu, chatter_hz) = solver.chatter_frequency_hz(&model, speed_rpm, depth_mm * 1e-3)?;
     let json = serde_json::json!({
         "speed_rpm": speed_rpm,
@@ -238,36 +262,55 @@ pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Meth
     Ok(())
 }
 
-/// `chatter demo`: the main job on the embedded examples, results into a folder.
+/// What `--out` of `chatter demo` may hold (the folder of its previous run).
+pub const DEMO_FILES: [&str; 11] = [
+    "turning_lobes.csv",
+    "turning_lobes.svg",
+    "eq34_covariance.json",
+    "turning_credibility.csv",
+    "turning_credibility.svg",
+    "milling_bands.svg",
+    "milling_frf.csv",
+    "shopfloor_model.json",
+    "shopfloor_observations.json",
+    "diagnosis",
+    "summary.json",
+];
+
+/// `chatter demo`: the main job on the embedded examples, results into a folder that appears
+/// complete or not at all.
 pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     use chatter_dynamics::examples;
-    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
-    let mut written = Vec::new();
+    let mut folder = Folder::new("--out", out_dir, &DEMO_FILES)?;
     let mut summary = serde_json::Map::new();
+    let stage = |k: usize, what: &str| {
+        if !quiet {
+            eprintln!("demo {k}/4: {what}");
+        }
+    };
 
     // 1. Turning case of seed 000: lobes (FDM and exact ZOA) over the tested speeds with the cuts.
+    stage(1, "turning lobes of seed 000");
     let turning = examples::ahmadi_2022_turning();
     let obs = examples::ahmadi_2022_turning_observations();
     let speeds: Vec<f64> = (0..=120).map(|i| 6800.0 + 7.5 * i as f64).collect();
     let fdm = compute_lobes(&turning, Method::Fdm, &speeds, quiet)?;
-    let path = out_dir.join("turning_lobes.csv");
-    write_atomic(&path, lobes_csv(&fdm).as_bytes())?;
-    written.push(path);
-    let path = out_dir.join("turning_lobes.svg");
-    line_chart(
-        &path,
-        "Seed 000 turning tool: nominal lobes (FDM) and test cuts",
-        "spindle speed (rpm)",
-        "width of cut (mm)",
-        &[Series {
-            label: "FDM limiting width".into(),
-            points: fdm.iter().map(|p| (p.speed_rpm, p.depth_mm())).collect(),
-            color: BLUE,
-            dashed: false,
-        }],
-        markers(Some(&obs)).as_ref(),
-    )?;
-    written.push(path);
+    folder.add("turning_lobes.csv", lobes_csv(&fdm));
+    folder.add(
+        "turning_lobes.svg",
+        line_chart_svg(
+            "Seed 000 turning tool: nominal lobes (FDM) and test cuts",
+            "spindle speed (rpm)",
+            "width of cut (mm)",
+            &[Series {
+                label: "FDM limiting width".into(),
+                points: fdm.iter().map(|p| (p.speed_rpm, p.depth_mm())).collect(),
+                color: BLUE,
+                dashed: false,
+            }],
+            markers(Some(&obs)).as_ref(),
+        )?,
+    );
     let at = |rpm: f64| {
         fdm.iter()
             .min_by(|a, b| (a.speed_rpm - rpm).abs().total_cmp(&(b.speed_rpm - rpm).abs()))
@@ -280,24 +323,23 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
 
     // 2. Credibility bounds of the same case with the posterior covariance of Eq. 34 (written
     //    out as a covariance file that `chatter bands --covariance` reads).
+    stage(2, "credibility bounds with the Eq. 34 covariance");
     let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
     let eq34 = vec![
         vec![3.5e-7, -2.9e-5, -1.5e-5],
         vec![-2.9e-5, 0.0042, 0.0019],
         vec![-1.5e-5, 0.0019, 9.4e-4],
     ];
-    let path = out_dir.join("eq34_covariance.json");
     let file = serde_json::json!({"parameter_names": names, "covariance": eq34});
-    write_atomic(&path, serde_json::to_string_pretty(&file)?.as_bytes())?;
+    folder.add("eq34_covariance.json", serde_json::to_string_pretty(&file)?);
     let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
     let dist = chatter_uncertainty::parameters::ParameterDistribution::new(
         &names,
         vec![0.0; 3],
         eq34,
         None,
-        &path,
+        &folder.path_of("eq34_covariance.json"),
     )?;
-    written.push(path);
     let coarse: Vec<f64> = (0..=36).map(|i| 6800.0 + 25.0 * i as f64).collect();
     let depths: Vec<f64> = (0..=60).map(|j| 1.0 + 0.05 * j as f64).collect();
     let (csv, series) = crate::bands::credibility_bands(
@@ -307,21 +349,20 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         &coarse,
         &depths,
     )?;
-    let path = out_dir.join("turning_credibility.csv");
-    write_atomic(&path, csv.as_bytes())?;
-    written.push(path);
-    let path = out_dir.join("turning_credibility.svg");
-    line_chart(
-        &path,
-        "Seed 000 turning tool: credibility bounds with the Eq. 34 covariance",
-        "spindle speed (rpm)",
-        "width of cut (mm)",
-        &series,
-        markers(Some(&obs)).as_ref(),
-    )?;
-    written.push(path);
+    folder.add("turning_credibility.csv", csv);
+    folder.add(
+        "turning_credibility.svg",
+        line_chart_svg(
+            "Seed 000 turning tool: credibility bounds with the Eq. 34 covariance",
+            "spindle speed (rpm)",
+            "width of cut (mm)",
+            &series,
+            markers(Some(&obs)).as_ref(),
+        )?,
+    );
 
     // 3. Milling example of seed 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm).
+    stage(3, "milling lobes of seed 001 with Type B offsets");
     let milling = examples::schmitz_2023_milling();
     let speeds: Vec<f64> = (0..=1000).map(|i| 4000.0 + 10.0 * i as f64).collect();
     let zoa = zoa_lobes(&milling, &speeds)?;
@@ -331,27 +372,26 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         .map(|p| (p.speed_rpm, p.depth_mm()))
         .collect();
     let bands = type_b_offsets(&curve, TypeBOffsets::new(100.0, 0.2)?)?;
-    let path = out_dir.join("milling_bands.svg");
-    line_chart(
-        &path,
-        "Seed 001 milling example: zero-order lobes with Type B offsets",
-        "spindle speed (rpm)",
-        "axial depth (mm)",
-        &crate::bands::band_series(
-            curve,
-            bands.lower.clone(),
-            bands.upper.clone(),
-            ["mean boundary", "lower offset", "upper offset"],
-        ),
-        None,
-    )?;
-    written.push(path);
-    let path = out_dir.join("milling_frf.csv");
-    write_atomic(&path, frf_csv(&milling, 0.0, 1500.0, 301, 0, 0).as_bytes())?;
-    written.push(path);
+    folder.add(
+        "milling_bands.svg",
+        line_chart_svg(
+            "Seed 001 milling example: zero-order lobes with Type B offsets",
+            "spindle speed (rpm)",
+            "axial depth (mm)",
+            &crate::bands::band_series(
+                curve,
+                bands.lower.clone(),
+                bands.upper.clone(),
+                ["mean boundary", "lower offset", "upper offset"],
+            ),
+            None,
+        )?,
+    );
+    folder.add("milling_frf.csv", frf_csv(&milling, 0.0, 1500.0, 301, 0, 0));
 
     // 4. Sim-to-real gap: a synthetic shop-floor campaign of a milling machine whose process
     //    damping the nominal model leaves out, diagnosed from the nominal model and the data.
+    stage(4, "sim-to-real gap diagnosis of a synthetic campaign");
     let nominal = chatter_gap::nominal_milling()?;
     let mut scenario = chatter_gap::Scenario::new(chatter_gap::HiddenEffect::ParameterError, 101);
     (scenario.effect, _) = chatter_gap::generator::effect_at(
@@ -361,38 +401,32 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         scenario.speed_range_rpm,
     )?;
     let campaign = chatter_gap::synthesize(&nominal, &scenario)?;
-    let model_path = out_dir.join("shopfloor_model.json");
-    write_atomic(
-        &model_path,
-        serde_json::to_string_pretty(&chatter_dynamics::ModelFile::from_model(&nominal))?
-            .as_bytes(),
+    folder.add(
+        "shopfloor_model.json",
+        serde_json::to_string_pretty(&chatter_dynamics::ModelFile::from_model(&nominal))?,
+    );
+    folder.add("shopfloor_observations.json", campaign.to_json_string());
+    let (model_path, obs_path) = (
+        folder.path_of("shopfloor_model.json"),
+        folder.path_of("shopfloor_observations.json"),
+    );
+    let (diagnosis, report, files) = crate::diagnose::report_of(
+        &nominal,
+        &campaign,
+        &crate::diagnose::DiagnoseRequest {
+            model: &model_path,
+            observations: &obs_path,
+            seed: 1,
+            samples: 120,
+            validation: crate::diagnose::ValidationArg::Kfold,
+            folds: 3,
+            out: Some(&folder.path_of("diagnosis")),
+            quiet,
+        },
     )?;
-    written.push(model_path.clone());
-    let obs_path = out_dir.join("shopfloor_observations.json");
-    write_atomic(&obs_path, campaign.to_json_string().as_bytes())?;
-    written.push(obs_path.clone());
-    let diagnosis_dir = out_dir.join("diagnosis");
-    std::fs::create_dir_all(&diagnosis_dir)
-        .with_context(|| format!("creating {}", diagnosis_dir.display()))?;
-    let (diagnosis, report) = crate::diagnose::report(&crate::diagnose::DiagnoseRequest {
-        model: &model_path,
-        observations: &obs_path,
-        seed: 1,
-        samples: 120,
-        validation: crate::diagnose::ValidationArg::Kfold,
-        folds: 3,
-        out: Some(&diagnosis_dir),
-        quiet,
-    })?;
-    let path = diagnosis_dir.join("report.json");
-    write_atomic(&path, report.as_bytes())?;
-    for f in [
-        "report.json",
-        "diagnosis.json",
-        "lobes.svg",
-        "residuals.svg",
-    ] {
-        written.push(diagnosis_dir.join(f));
+    folder.add("diagnosis/report.json", report);
+    for (name, bytes) in files {
+        folder.add(Path::new("diagnosis").join(name), bytes);
     }
     summary.insert(
         "diagnosis".into(),
@@ -402,19 +436,15 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         }),
     );
 
-    summary.insert(
-        "files".into(),
-        serde_json::json!(
-            written
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-        ),
-    );
-    let path = out_dir.join("summary.json");
-    write_atomic(&path, serde_json::to_string_pretty(&summary)?.as_bytes())?;
-    written.push(path);
-    for p in &written {
+    let mut files: Vec<String> = folder
+        .paths()
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    files.push(folder.path_of("summary.json").display().to_string());
+    summary.insert("files".into(), serde_json::json!(files));
+    folder.add("summary.json", serde_json::to_string_pretty(&summary)?);
+    for p in folder.commit()? {
         println!("wrote {}", p.display());
     }
     Ok(())

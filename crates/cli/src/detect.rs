@@ -19,7 +19,7 @@ use anyhow::{Context, Result, bail};
 use chatter_dynamics::{Cut, CutEvidence, ModalModel, Observations, Operation, SignalRecord};
 use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
 use plotters::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `chatter detect`.
 #[derive(Debug, clap::Args)]
@@ -44,18 +44,33 @@ pub struct DetectArgs {
 
 /// `chatter detect`.
 pub fn run(args: &DetectArgs) -> Result<()> {
+    crate::output::check_optional_file("--out", args.out.as_deref())?;
     let observations = crate::inputs::observations(&args.observations)?;
     let model = args
         .model
         .as_deref()
         .map(crate::inputs::model)
         .transpose()?;
+    if let (Some(m), Some(path)) = (&model, &args.model) {
+        crate::validate::observations_match(m, &observations, &args.observations, path)?;
+    }
     if observations.signals.is_empty() {
         bail!(
             "{}: no `signals` to examine; expected at least one entry with a `file`",
             args.observations.display()
         );
     }
+    let plot_names: Vec<String> = (1..=observations.signals.len())
+        .map(|i| format!("detect-{i}.svg"))
+        .collect();
+    let mut plots = args
+        .plot
+        .as_deref()
+        .map(|dir| {
+            let known: Vec<&str> = plot_names.iter().map(String::as_str).collect();
+            crate::output::Folder::new("--plot", dir, &known)
+        })
+        .transpose()?;
     let mut cuts = observations.cuts.clone();
     for (i, record) in observations.signals.iter().enumerate() {
         let context = || {
@@ -66,16 +81,23 @@ pub fn run(args: &DetectArgs) -> Result<()> {
             )
         };
         let signals = crate::inputs::signal_record(i, record).with_context(context)?;
+        if let Some(m) = &model {
+            crate::validate::channels_match(m, &signals.names, &context())?;
+        }
         let mut options = DetectionOptions::new(record.speed_rpm / 60.0);
         options.once_per_rev_channel = record.once_per_rev_channel.clone();
         options.interference_hz = args.interference_hz.clone();
         let detection = detect(&signals, &options).with_context(context)?;
-        if let Some(dir) = &args.plot {
-            let path = dir.join(format!("detect-{}.svg", i + 1));
-            draw(&path, record, model.as_ref(), &detection).with_context(context)?;
-            eprintln!("wrote {}", path.display());
+        if let Some(folder) = &mut plots {
+            let svg = draw(record, model.as_ref(), &detection).with_context(context)?;
+            folder.add(format!("detect-{}.svg", i + 1), svg);
         }
         cuts.push(cut(record, &detection));
+    }
+    if let Some(folder) = plots {
+        for path in folder.commit()? {
+            eprintln!("wrote {}", path.display());
+        }
     }
     let result = Observations {
         cuts,
@@ -114,12 +136,7 @@ fn cut(record: &SignalRecord, d: &Detection) -> Cut {
 
 /// The spectrum (log scale) over the band, the harmonics as grey ticks, the line as a red
 /// marker.
-fn draw(
-    path: &Path,
-    record: &SignalRecord,
-    model: Option<&ModalModel>,
-    d: &Detection,
-) -> Result<()> {
+fn draw(record: &SignalRecord, model: Option<&ModalModel>, d: &Detection) -> Result<String> {
     let (lo, hi) = d.band_hz;
     let points: Vec<(f64, f64)> = d
         .spectrum
@@ -198,5 +215,5 @@ fn draw(
             .map_err(e)?;
         root.present().map_err(e)?;
     }
-    crate::output::write_atomic(path, svg.as_bytes())
+    Ok(svg)
 }

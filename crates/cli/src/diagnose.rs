@@ -1,9 +1,9 @@
 //! `chatter diagnose`: the sim-to-real gap between a model and shop-floor observations.
 
-use crate::output::write_atomic;
-use crate::plot::{Markers, Series, line_chart};
+use crate::output::Folder;
+use crate::plot::{Markers, Series, line_chart_svg};
 use crate::{inputs, progress::Bar};
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use chatter_gap::{
     DiagnoseOptions, Diagnosis, DiagnosisObserver, EffectClass, Validation, diagnose,
 };
@@ -70,18 +70,89 @@ impl DiagnosisObserver for Progress {
     }
 }
 
-/// `chatter diagnose`: the report JSON on stdout.
-pub fn run(r: &DiagnoseRequest) -> Result<()> {
-    let (_, json) = report(r)?;
+/// Files of a result: name and content.
+pub type Files = Vec<(String, Vec<u8>)>;
+
+/// What `--out` of `chatter diagnose` may hold.
+pub const FILES: [&str; 5] = [
+    "diagnosis.json",
+    "diagnosed_model.json",
+    "diagnosed_effects.json",
+    "lobes.svg",
+    "residuals.svg",
+];
+
+/// `chatter diagnose`: the report JSON on stdout, the files in `--out`.
+pub fn run(r: &DiagnoseRequest, folds_given: bool) -> Result<()> {
+    let folder = r
+        .out
+        .map(|dir| Folder::new("--out", dir, &FILES))
+        .transpose()?;
+    if folds_given && r.validation == ValidationArg::Off {
+        bail!("--folds is not used with --validation off; it is for kfold and speed-bands");
+    }
+    let (_, json, files) = report(r)?;
+    if let Some(mut folder) = folder {
+        for (name, bytes) in files {
+            folder.add(name, bytes);
+        }
+        folder.commit()?;
+    }
     let mut stdout = std::io::stdout().lock();
     writeln!(stdout, "{json}").context("writing to stdout")
 }
 
-/// The diagnosis and its report JSON; with `out`, also `diagnosis.json`, `lobes.svg` and
-/// `residuals.svg` there.
-pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String)> {
+/// The diagnosis, its report JSON and, with `out`, the files `diagnosis.json`,
+/// `diagnosed_model.json` (and `diagnosed_effects.json`), `lobes.svg` and `residuals.svg` (name
+/// and content; the caller writes them).
+pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String, Files)> {
     let model = inputs::model(r.model)?;
     let observations = inputs::observations(r.observations)?;
+    report_of(&model, &observations, r)
+}
+
+/// [`report`] of a model and observations already read (`r.model` and `r.observations` name
+/// them in messages).
+pub fn report_of(
+    model: &chatter_dynamics::ModalModel,
+    observations: &chatter_dynamics::Observations,
+    r: &DiagnoseRequest,
+) -> Result<(Diagnosis, String, Files)> {
+    crate::validate::observations_match(model, observations, r.observations, r.model)?;
+    crate::validate::observation_work_size(model, observations, r.observations)?;
+    // k-fold splits the entries, speed bands split the distinct speeds
+    let speeds = observations
+        .cuts
+        .iter()
+        .map(|c| c.speed_rpm)
+        .chain(observations.poles.iter().map(|p| p.speed_rpm));
+    let (available, what) = match r.validation {
+        ValidationArg::Kfold => (
+            observations.cuts.len() + observations.poles.len(),
+            "cuts and poles",
+        ),
+        ValidationArg::SpeedBands => {
+            let mut distinct: Vec<f64> = speeds.collect();
+            distinct.sort_by(f64::total_cmp);
+            distinct.dedup();
+            (distinct.len(), "distinct speeds")
+        }
+        ValidationArg::Off => (usize::MAX, ""),
+    };
+    if available > 0 && r.folds > available {
+        bail!(
+            "--folds {}: {} holds {available} {what}; expected at most one fold per entry",
+            r.folds,
+            r.observations.display()
+        );
+    }
+    crate::validate::count(
+        "--samples",
+        r.samples,
+        40,
+        100_000,
+        "samples per model class",
+    )?;
     let validation = match r.validation {
         ValidationArg::Kfold => Validation::KFold { folds: r.folds },
         ValidationArg::SpeedBands => Validation::SpeedBands { bands: r.folds },
@@ -106,7 +177,7 @@ pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String)> {
         ),
         done: AtomicUsize::new(0),
     };
-    let diagnosis = diagnose(&model, &observations, &options, &progress).with_context(|| {
+    let diagnosis = diagnose(model, observations, &options, &progress).with_context(|| {
         format!(
             "diagnosing {} against {}",
             r.observations.display(),
@@ -127,13 +198,14 @@ pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String)> {
         nominal_check: &d.nominal_check,
         notes: &d.notes,
     };
-    if let Some(dir) = r.out {
+    let mut files: Files = Vec::new();
+    if r.out.is_some() {
         let full = serde_json::to_string_pretty(&diagnosis)?;
-        write_atomic(&dir.join("diagnosis.json"), full.as_bytes())?;
-        write_atomic(
-            &dir.join("diagnosed_model.json"),
-            diagnosis.diagnosed_model().to_json_string().as_bytes(),
-        )?;
+        files.push(("diagnosis.json".into(), full.into_bytes()));
+        files.push((
+            "diagnosed_model.json".into(),
+            diagnosis.diagnosed_model().to_json_string().into_bytes(),
+        ));
         let (softening_per_rpm2, drift_rate) = diagnosis.diagnosed_effects();
         if softening_per_rpm2 != 0.0 || drift_rate != 0.0 {
             let effects = serde_json::json!({
@@ -141,20 +213,23 @@ pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String)> {
                 "natural_frequency_softening_per_rpm2": softening_per_rpm2,
                 "cutting_coefficient_drift_over_campaign": drift_rate,
             });
-            write_atomic(
-                &dir.join("diagnosed_effects.json"),
-                serde_json::to_string_pretty(&effects)?.as_bytes(),
-            )?;
+            files.push((
+                "diagnosed_effects.json".into(),
+                serde_json::to_string_pretty(&effects)?.into_bytes(),
+            ));
         }
-        lobe_plot(&diagnosis, &dir.join("lobes.svg"))?;
-        residual_map(&diagnosis, &dir.join("residuals.svg"))?;
+        files.push(("lobes.svg".into(), lobe_plot(&diagnosis)?.into_bytes()));
+        files.push((
+            "residuals.svg".into(),
+            residual_map(&diagnosis)?.into_bytes(),
+        ));
     }
     let json = serde_json::to_string_pretty(&report)?;
-    Ok((diagnosis, json))
+    Ok((diagnosis, json, files))
 }
 
 /// Lobes of the nominal and the diagnosed model over the observed cuts.
-fn lobe_plot(d: &Diagnosis, path: &Path) -> Result<()> {
+fn lobe_plot(d: &Diagnosis) -> Result<String> {
     let cuts = &d.residuals.nominal.cuts;
     let (lo, hi) = cuts
         .iter()
@@ -198,8 +273,7 @@ fn lobe_plot(d: &Diagnosis, path: &Path) -> Result<()> {
             .map(|c| (c.speed_rpm, c.depth_mm))
             .collect(),
     };
-    line_chart(
-        path,
+    line_chart_svg(
         &format!("verdict: {}", d.verdict.name()),
         "spindle speed (rpm)",
         "limiting depth (mm)",
@@ -210,7 +284,7 @@ fn lobe_plot(d: &Diagnosis, path: &Path) -> Result<()> {
 
 /// Every cut at its depth over the nominal limit: circles above 1 and crosses below 1 disagree
 /// with the nominal model; the diagnosed limit over the nominal one is drawn as dots.
-fn residual_map(d: &Diagnosis, path: &Path) -> Result<()> {
+fn residual_map(d: &Diagnosis) -> Result<String> {
     let nominal = &d.residuals.nominal.cuts;
     let diagnosed = &d.residuals.diagnosed.cuts;
     let ratio = |c: &chatter_gap::regions::CutResidual| (c.speed_rpm, c.depth_mm / c.limit_mm);
@@ -247,8 +321,7 @@ fn residual_map(d: &Diagnosis, path: &Path) -> Result<()> {
             .filter(|p| p.1.is_finite())
             .collect(),
     };
-    line_chart(
-        path,
+    line_chart_svg(
         "cuts relative to the nominal boundary",
         "spindle speed (rpm)",
         "depth / nominal limiting depth",

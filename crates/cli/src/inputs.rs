@@ -1,6 +1,6 @@
 //! Loading the user's files with errors that name them.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use chatter_dynamics::{ModalModel, Observations, SignalRecord};
 use chatter_oma::signals::Signals;
 use std::path::Path;
@@ -13,40 +13,6 @@ pub fn model(path: &Path) -> Result<ModalModel> {
 /// Read and validate an observations file (JSON or cuts CSV).
 pub fn observations(path: &Path) -> Result<Observations> {
     Observations::from_path(path).context("reading the observations file")
-}
-
-/// Parse `MIN:MAX:N` speeds (rpm).
-pub fn speeds(spec: &str) -> Result<Vec<f64>> {
-    let (min, max, n) = range("--speeds", spec)?;
-    Ok(chatter_stability::boundary::speed_range(min, max, n)?)
-}
-
-/// Parse a `MIN:MAX:N` grid of `flag` with `floor <= MIN < MAX` and `N >= 2`.
-pub fn grid(flag: &str, spec: &str, floor: f64) -> Result<Vec<f64>> {
-    let (min, max, n) = range(flag, spec)?;
-    if !(min >= floor && max > min && n >= 2) {
-        bail!("{flag} `{spec}`: expected {floor} <= MIN < MAX and N >= 2");
-    }
-    Ok((0..n)
-        .map(|i| min + (max - min) * i as f64 / (n - 1) as f64)
-        .collect())
-}
-
-fn range(flag: &str, spec: &str) -> Result<(f64, f64, usize)> {
-    let parts: Vec<&str> = spec.split(':').collect();
-    if parts.len() != 3 {
-        bail!("{flag} `{spec}`: expected MIN:MAX:N, e.g. 3000:15000:200");
-    }
-    let min: f64 = parts[0]
-        .parse()
-        .with_context(|| format!("{flag} MIN `{}`", parts[0]))?;
-    let max: f64 = parts[1]
-        .parse()
-        .with_context(|| format!("{flag} MAX `{}`", parts[1]))?;
-    let n: usize = parts[2]
-        .parse()
-        .with_context(|| format!("{flag} N `{}`", parts[2]))?;
-    Ok((min, max, n))
 }
 
 /// The record's channels: CSV at the entry's rate, WAV or MP3 at their own.

@@ -1,6 +1,8 @@
 //! `chatter`: stability lobes, multipliers, uncertainty bands and the demo, over the
 //! chatter-* crates. Thin by design: parse, call, write.
 
+#![cfg_attr(test, allow(clippy::unwrap_used))]
+
 mod bands;
 mod commands;
 mod detect;
@@ -14,6 +16,7 @@ mod plot;
 mod progress;
 mod rcsa;
 mod update;
+mod validate;
 
 use bands::BandKind;
 use clap::{Parser, Subcommand};
@@ -127,24 +130,24 @@ enum Command {
         /// 1.5 times the deepest limit, 100 depths.
         #[arg(long)]
         depths: Option<String>,
-        /// Speed offset (rpm), geometric.
-        #[arg(long, default_value_t = 100.0)]
-        offset_rpm: f64,
-        /// Depth offset (mm), geometric.
-        #[arg(long, default_value_t = 0.2)]
-        offset_mm: f64,
+        /// Speed offset (rpm), geometric; default 100.
+        #[arg(long)]
+        offset_rpm: Option<f64>,
+        /// Depth offset (mm), geometric; default 0.2.
+        #[arg(long)]
+        offset_mm: Option<f64>,
         /// Posterior folder of `chatter update` (summary.json, posterior.csv).
         #[arg(long)]
         posterior: Option<PathBuf>,
         /// Covariance file: {"parameter_names": [...], "covariance": [[...]], "mean": [...]}.
         #[arg(long)]
         covariance: Option<PathBuf>,
-        /// Monte Carlo parameter samples.
-        #[arg(long, default_value_t = 500)]
-        samples: usize,
-        /// Seed of the Monte Carlo draws.
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
+        /// Monte Carlo parameter samples; default 500.
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Seed of the Monte Carlo draws; default 0.
+        #[arg(long)]
+        seed: Option<u64>,
         /// Observed cuts to draw.
         #[arg(long)]
         observations: Option<PathBuf>,
@@ -212,9 +215,9 @@ enum Command {
         /// Held-out validation of the shrinkage.
         #[arg(long, value_enum, default_value = "kfold")]
         validation: diagnose::ValidationArg,
-        /// Folds (or speed bands) of the validation.
-        #[arg(long, default_value_t = 3)]
-        folds: usize,
+        /// Folds (or speed bands) of the validation; default 3.
+        #[arg(long)]
+        folds: Option<usize>,
         /// Folder for diagnosis.json (with residuals), lobes.svg and residuals.svg.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -275,9 +278,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         } => {
             let range = match (fmin_hz, fmax_hz) {
                 (None, None) => None,
-                (a, Some(b)) => Some((a.unwrap_or(0.0), b)),
-                (Some(a), None) => anyhow::bail!("--fmin-hz {a} needs --fmax-hz"),
+                (a, Some(b)) => Some((
+                    validate::option("--fmin-hz", a.unwrap_or(0.0), &validate::FRF_HZ)?,
+                    validate::option("--fmax-hz", b, &validate::FRF_HZ)?,
+                )),
+                (Some(a), None) => anyhow::bail!(
+                    "--fmin-hz {} needs --fmax-hz",
+                    validate::as_typed("--fmin-hz", a)
+                ),
             };
+            validate::count("--points", points, 2, validate::MAX_POINTS, "frequencies")?;
+            output::check_optional_file("--out", out.as_deref())?;
+            output::check_optional_file("--plot", plot.as_deref())?;
             commands::frf(
                 &model,
                 range,
@@ -308,7 +320,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             speed_rpm,
             depth_mm,
             method,
-        } => commands::multiplier(&model, speed_rpm, depth_mm, method),
+        } => commands::multiplier(
+            &model,
+            validate::option(
+                "--speed-rpm",
+                speed_rpm,
+                &chatter_dynamics::limits::SPEED_RPM,
+            )?,
+            validate::option("--depth-mm", depth_mm, &chatter_dynamics::limits::DEPTH_MM)?,
+            method,
+        ),
         Command::Bands {
             model,
             kind,
@@ -355,7 +376,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             harmonic_force_n,
             feed_per_tooth_mm,
         } => {
+            use chatter_dynamics::limits::{DEPTH_MM, SAMPLE_RATE_HZ, SPEED_RPM};
             use chatter_dynamics::simulate::{Quantity, SimulationSettings};
+            validate::option("--speed-rpm", speed_rpm, &SPEED_RPM)?;
+            validate::option("--depth-mm", depth_mm, &DEPTH_MM)?;
+            validate::option("--duration-s", duration_s, &validate::DURATION_S)?;
+            validate::option("--sample-rate-hz", sample_rate_hz, &SAMPLE_RATE_HZ)?;
+            validate::option("--random-force-n", random_force_n, &validate::FORCE_N)?;
+            validate::option("--harmonic-force-n", harmonic_force_n, &validate::FORCE_N)?;
+            validate::option("--feed-per-tooth-mm", feed_per_tooth_mm, &validate::FEED_MM)?;
+            validate::simulation_length(duration_s, sample_rate_hz)?;
+            output::check_file("--out", &out)?;
             let mut s = SimulationSettings::new(
                 speed_rpm,
                 depth_mm * 1e-3,
@@ -381,16 +412,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             validation,
             folds,
             out,
-        } => diagnose::run(&diagnose::DiagnoseRequest {
-            model: &model,
-            observations: &observations,
-            seed,
-            samples,
-            validation,
-            folds,
-            out: out.as_deref(),
-            quiet,
-        }),
+        } => diagnose::run(
+            &diagnose::DiagnoseRequest {
+                model: &model,
+                observations: &observations,
+                seed,
+                samples,
+                validation,
+                folds: folds.unwrap_or(3),
+                out: out.as_deref(),
+                quiet,
+            },
+            folds.is_some(),
+        ),
         Command::Update(args) => update::run(&args, quiet),
         Command::Plan(args) => plan::run(&args, quiet),
         Command::Detect(args) => detect::run(&args),
@@ -401,9 +435,55 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// The command line with negative numbers accepted as option values (`--depth-mm -1` reaches
+/// the range check instead of being taken for a flag) and the `MIN:MAX:N` and list options
+/// taking values that start with a hyphen.
+fn command() -> clap::Command {
+    use clap::CommandFactory;
+    const HYPHEN_VALUES: [&str; 5] = [
+        "speeds",
+        "depths",
+        "classes",
+        "harmonics_hz",
+        "interference_hz",
+    ];
+    Cli::command().mut_subcommands(|sub| {
+        let mut sub = sub.allow_negative_numbers(true);
+        for id in HYPHEN_VALUES {
+            if sub.get_arguments().any(|a| a.get_id() == id) {
+                sub = sub.mut_arg(id, |a| a.allow_hyphen_values(true));
+            }
+        }
+        sub
+    })
+}
+
+/// The error and its causes on one line, each cause once: a cause whose text its parent
+/// already quotes (an OS error inside a file error) is not repeated.
+fn message(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if text.contains(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
+}
+
 fn main() {
-    if let Err(e) = run(Cli::parse()) {
-        eprintln!("error: {e:#}");
+    use clap::FromArgMatches;
+    let matches = command().get_matches();
+    if let Some((_, sub)) = matches.subcommand() {
+        validate::remember_typed(sub);
+    }
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let Err(e) = run(cli) {
+        eprintln!("error: {}", message(&e));
         std::process::exit(1);
     }
 }

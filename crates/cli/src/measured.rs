@@ -39,7 +39,7 @@ pub fn lobes(
     }
     let model = MeasuredModel::from_path(model_path).context("reading the measured FRFs")?;
     let speeds = match speeds {
-        Some(s) => crate::inputs::speeds(s)?,
+        Some(s) => crate::validate::speeds(s)?,
         None => {
             let f = model.receptance.peak_frequency_hz();
             let n = model.operation.delays_per_revolution() as f64;
@@ -93,6 +93,20 @@ pub struct FitFrfArgs {
 
 /// `chatter fit-frf`: prints the fit report (complex modes, residual terms, misfits) as JSON.
 pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
+    let fmin = crate::validate::option("--fmin-hz", args.fmin_hz, &crate::validate::FRF_HZ)?;
+    let fmax = crate::validate::option("--fmax-hz", args.fmax_hz, &crate::validate::FRF_HZ)?;
+    if fmax <= fmin {
+        bail!(
+            "--fmax-hz {}: expected above --fmin-hz {}",
+            crate::validate::as_typed("--fmax-hz", fmax),
+            crate::validate::as_typed("--fmin-hz", fmin)
+        );
+    }
+    if let Some(n) = args.modes {
+        crate::validate::count("--modes", n, 1, 50, "modes")?;
+    }
+    crate::output::check_file("--out", &args.out)?;
+    crate::output::check_optional_file("--plot", args.plot.as_deref())?;
     let frf = read_frf(&args.frf, args.dataset).context("reading the FRF")?;
     let options = FitOptions {
         modes: args.modes,

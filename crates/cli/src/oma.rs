@@ -83,12 +83,28 @@ pub struct OmaArgs {
 
 /// `chatter oma`.
 pub fn run(args: &OmaArgs) -> Result<()> {
+    use crate::validate::count;
+    for (flag, value, max, what) in [
+        ("--segments", args.segments, 200, "random segments"),
+        ("--min-order", args.min_order, 200, "model orders"),
+        ("--max-order", args.max_order, 200, "model orders"),
+        ("--decimation", args.decimation, 1000, "a decimation factor"),
+    ] {
+        if let Some(n) = value {
+            count(flag, n, 1, max, what)?;
+        }
+    }
+    crate::output::check_optional_file("--out", args.out.as_deref())?;
+    crate::output::check_optional_file("--plot", args.plot.as_deref())?;
     let observations = crate::inputs::observations(&args.observations)?;
     let model = args
         .model
         .as_deref()
         .map(crate::inputs::model)
         .transpose()?;
+    if let (Some(m), Some(path)) = (&model, &args.model) {
+        crate::validate::observations_match(m, &observations, &args.observations, path)?;
+    }
     if observations.signals.is_empty() {
         bail!(
             "{}: no `signals` to identify; expected at least one entry with a `file`",
@@ -161,6 +177,9 @@ fn analyse(
     args: &OmaArgs,
 ) -> Result<Analysis> {
     let mut signals = crate::inputs::signal_record(i, record)?;
+    if let Some(m) = model {
+        crate::validate::channels_match(m, &signals.names, &format!("signals[{i}]"))?;
+    }
     let mut revolution_s = 60.0 / record.speed_rpm;
     if let Some(name) = &record.once_per_rev_channel {
         let c = signals.channel(name).with_context(|| {

@@ -30,9 +30,9 @@ pub struct PlanArgs {
     /// voi (003) or mrr (004).
     #[arg(long, value_enum)]
     strategy: StrategyArg,
-    /// Probability of stability of the tested contour (mrr).
-    #[arg(long, default_value_t = 0.5)]
-    p_test: f64,
+    /// Probability of stability of the tested contour (mrr); default 0.5.
+    #[arg(long)]
+    p_test: Option<f64>,
     /// Sampled parameters, comma-separated; default kt_n_per_mm2,kn_n_per_mm2 (+ c_n_per_m with
     /// process damping).
     #[arg(long)]
@@ -71,8 +71,47 @@ impl EnsembleObserver for PathProgress {
 
 /// Run `chatter plan`: print the next cut as JSON on stdout.
 pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
+    use crate::validate;
+    let voi = args.strategy == StrategyArg::Voi;
+    validate::unused(
+        voi && args.p_test.is_some(),
+        "--p-test",
+        "with --strategy voi",
+        "--strategy mrr",
+    )?;
+    validate::unused(
+        !voi && args.target.is_some(),
+        "--target",
+        "with --strategy mrr",
+        "--strategy voi",
+    )?;
+    if let Some(p) = args.p_test {
+        validate::option("--p-test", p, &validate::PROBABILITY)?;
+    }
+    validate::count("--paths", args.paths, 10, 100_000, "sampled boundaries")?;
+    validate::option(
+        "--feed-per-tooth-mm",
+        args.feed_per_tooth_mm,
+        &validate::FEED_MM,
+    )?;
+    let speeds = args.speeds.as_deref().map(validate::speeds).transpose()?;
+    let depths = args
+        .depths
+        .as_deref()
+        .map(|s| validate::grid("--depths", s, &validate::DEPTH_GRID_MM))
+        .transpose()?;
     let model = crate::inputs::model(&args.model)?;
     let observations = crate::inputs::observations(&args.observations)?;
+    validate::observations_match(&model, &observations, &args.observations, &args.model)?;
+    validate::observation_work_size(&model, &observations, &args.observations)?;
+    if let Some(s) = &speeds {
+        validate::work_size(
+            &model,
+            chatter_stability::monodromy::Discretization::full(),
+            s,
+            "--speeds",
+        )?;
+    }
     let priors: PriorOverrides = match &args.priors {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -87,7 +126,7 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
             StrategyArg::Voi => Strategy::ValueOfInformation,
             StrategyArg::Mrr => Strategy::MaterialRemovalRate,
         },
-        p_test: args.p_test,
+        p_test: args.p_test.unwrap_or(0.5),
         parameters: args
             .parameters
             .as_deref()
@@ -96,22 +135,13 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         priors,
         target: args.target.as_deref().map(str::parse).transpose()?,
         paths: args.paths,
-        speeds_rpm: args
-            .speeds
-            .as_deref()
-            .map(crate::inputs::speeds)
-            .transpose()?,
-        depths_m: args
-            .depths
-            .as_deref()
-            .map(|s| crate::inputs::grid("--depths", s, 0.0))
-            .transpose()?
-            .map(|d| {
-                d.into_iter()
-                    .filter(|v| *v > 0.0)
-                    .map(|v| v * 1e-3)
-                    .collect()
-            }),
+        speeds_rpm: speeds,
+        depths_m: depths.map(|d| {
+            d.into_iter()
+                .filter(|v| *v > 0.0)
+                .map(|v| v * 1e-3)
+                .collect()
+        }),
         feed_per_tooth_m: args.feed_per_tooth_mm * 1e-3,
         seed: args.seed,
     };

@@ -42,6 +42,18 @@ pub fn line_chart(
     series: &[Series],
     markers: Option<&Markers>,
 ) -> Result<()> {
+    let svg = line_chart_svg(title, x_label, y_label, series, markers)?;
+    crate::output::write_atomic(path, svg.as_bytes())
+}
+
+/// The SVG text of [`line_chart`].
+pub fn line_chart_svg(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    markers: Option<&Markers>,
+) -> Result<String> {
     let all = series.iter().flat_map(|s| s.points.iter().copied()).chain(
         markers
             .into_iter()
@@ -118,7 +130,7 @@ pub fn line_chart(
             .map_err(|e| anyhow!("{e}"))?;
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    crate::output::write_atomic(path, svg.as_bytes())
+    Ok(svg)
 }
 
 /// A panel of [`error_bar_panels`]: y label and points (x, mean, standard deviation).

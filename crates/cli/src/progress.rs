@@ -1,43 +1,94 @@
-//! Progress bars on stderr for long work; silent with `--quiet`.
+//! Progress of long work on stderr; silent with `--quiet`.
+//!
+//! On a terminal an indicatif bar with the elapsed time and an ETA; otherwise (a log file, a
+//! pipe) one line at most every [`LOG_EVERY`] with done/total, the elapsed time and the ETA, so
+//! that long runs are visible in logs too.
 
 use chatter_stability::boundary::BoundaryObserver;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
-/// An indicatif bar (hidden when quiet) that implements the library observers.
-pub struct Bar(ProgressBar);
+/// Least time between two progress lines when stderr is not a terminal.
+pub const LOG_EVERY: Duration = Duration::from_secs(5);
+
+/// A progress report (hidden when quiet) that implements the library observers.
+pub struct Bar {
+    bar: ProgressBar,
+    /// Lines for logs: the last time one was written; None on a terminal or when quiet.
+    log: Option<Mutex<Instant>>,
+    message: String,
+}
 
 impl Bar {
-    /// A bar of `total` steps with a message.
+    /// A report of `total` steps with a message.
     pub fn new(total: u64, message: &str, quiet: bool) -> Self {
-        let bar = if quiet {
-            ProgressBar::hidden()
+        let terminal = std::io::stderr().is_terminal();
+        let bar = if quiet || !terminal {
+            // a hidden bar still keeps the position and the rate for the log lines
+            let b = ProgressBar::hidden();
+            b.set_length(total);
+            b
         } else {
             ProgressBar::new(total)
         };
-        if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed}") {
+        if let Ok(style) =
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed} (ETA {eta})")
+        {
             bar.set_style(style);
         }
         bar.set_message(message.to_string());
-        Self(bar)
+        Self {
+            bar,
+            log: (!quiet && !terminal).then(|| Mutex::new(Instant::now())),
+            message: message.to_string(),
+        }
     }
+
     /// Set the position.
     pub fn set(&self, done: usize) {
-        self.0.set_position(done as u64);
+        self.bar.set_position(done as u64);
+        self.log_line("");
     }
+
+    /// Progress inside the current step (e.g. a sampler's stage), shown beside the message.
+    pub fn detail(&self, text: &str) {
+        self.bar.set_message(format!("{} ({text})", self.message));
+        self.log_line(&format!(" ({text})"));
+    }
+
+    /// A line for logs, at most every [`LOG_EVERY`], when stderr is not a terminal.
+    fn log_line(&self, detail: &str) {
+        let Some(log) = &self.log else { return };
+        let Ok(mut last) = log.lock() else { return };
+        if last.elapsed() >= LOG_EVERY {
+            *last = Instant::now();
+            eprintln!(
+                "{}: {}/{}{detail}, {:.0} s elapsed, about {:.0} s left",
+                self.message,
+                self.bar.position(),
+                self.bar.length().unwrap_or(0),
+                self.bar.elapsed().as_secs_f64(),
+                self.bar.eta().as_secs_f64()
+            );
+        }
+    }
+
     /// Finish and clear.
     pub fn finish(&self) {
-        self.0.finish_and_clear();
+        self.bar.finish_and_clear();
     }
 }
 
 impl BoundaryObserver for Bar {
     fn speed_done(&self, done: usize, _total: usize) {
-        self.0.set_position(done as u64);
+        self.set(done);
     }
 }
 
 impl chatter_dynamics::simulate::SimulationObserver for Bar {
     fn progress(&self, fraction: f64) {
-        self.0.set_position((fraction * 1000.0) as u64);
+        self.set((fraction * 1000.0) as usize);
     }
 }

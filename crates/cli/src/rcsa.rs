@@ -25,6 +25,8 @@ pub struct RcsaArgs {
 
 /// `chatter rcsa`: predict, write the CSV, plot.
 pub fn rcsa(args: &RcsaArgs) -> Result<()> {
+    crate::output::check_optional_file("--out", args.out.as_deref())?;
+    crate::output::check_optional_file("--plot", args.plot.as_deref())?;
     let assembly = Assembly::from_path(&args.assembly).context("reading the assembly")?;
     let tip = assembly
         .tool_tip_frf()

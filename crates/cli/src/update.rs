@@ -1,7 +1,7 @@
 //! `chatter update`: Bayesian model updating (000, 002, 004) over model classes, writing the
 //! posterior samples, a summary, the updated model and evidence / corner plots.
 
-use crate::output::write_atomic;
+use crate::output::Folder;
 use crate::progress::Bar;
 use anyhow::{Context, Result, anyhow, bail};
 use chatter_bayes::tmcmc::SamplerObserver;
@@ -9,7 +9,7 @@ use chatter_updating::classes::{ClassObserver, Sampler, SamplerOptions};
 use chatter_updating::parameters::parse_model_parameters;
 use chatter_updating::update::{PriorOverrides, UpdateJob, UpdateResult, UpdateSettings};
 use plotters::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Posterior samplers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -59,7 +59,17 @@ pub struct UpdateArgs {
 /// Progress: one step per model class.
 struct ClassProgress(Bar);
 
-impl SamplerObserver for ClassProgress {}
+impl SamplerObserver for ClassProgress {
+    fn stage(&self, index: usize, beta: f64, acceptance: f64) {
+        self.0.detail(&format!(
+            "stage {index}, beta {beta:.3}, acceptance {acceptance:.2}"
+        ));
+    }
+    fn chain_progress(&self, chain: usize, done: usize, total: usize) {
+        self.0
+            .detail(&format!("chain {chain}: {done}/{total} samples"));
+    }
+}
 
 impl ClassObserver for ClassProgress {
     fn class_started(&self, index: usize, _total: usize, _alpha: f64) {
@@ -67,23 +77,45 @@ impl ClassObserver for ClassProgress {
     }
 }
 
+/// What `--out` of `chatter update` may hold.
+pub const FILES: [&str; 5] = [
+    "posterior.csv",
+    "summary.json",
+    "updated_model.json",
+    "evidence.svg",
+    "corner.svg",
+];
+
+/// `--classes`: distinct numbers > 0.
 fn parse_classes(spec: &str) -> Result<Vec<f64>> {
-    spec.split(',')
-        .map(str::trim)
-        .filter(|s| !s.is_empty())
-        .map(|s| {
-            s.parse::<f64>()
-                .ok()
-                .filter(|a| a.is_finite() && *a > 0.0)
-                .ok_or_else(|| anyhow!("--classes: `{s}` is not a number > 0"))
-        })
-        .collect()
+    let mut alphas: Vec<f64> = Vec::new();
+    for s in spec.split(',').map(str::trim) {
+        let alpha = s
+            .parse::<f64>()
+            .ok()
+            .filter(|a| a.is_finite() && *a > 0.0)
+            .ok_or_else(|| anyhow!("--classes {spec}: `{s}` is not a number > 0"))?;
+        if alphas.contains(&alpha) {
+            bail!("--classes {spec}: `{s}` is given twice; expected distinct classes");
+        }
+        alphas.push(alpha);
+    }
+    Ok(alphas)
 }
 
 /// Run `chatter update`.
 pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
+    let folder = Folder::new("--out", &args.out, &FILES)?;
+    crate::validate::count(
+        "--samples",
+        args.samples,
+        10,
+        1_000_000,
+        "samples per class",
+    )?;
     let model = crate::inputs::model(&args.model)?;
     let observations = crate::inputs::observations(&args.observations)?;
+    crate::validate::observations_match(&model, &observations, &args.observations, &args.model)?;
     let priors: PriorOverrides = match &args.priors {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -102,10 +134,15 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         priors,
         classes: args.classes.as_deref().map(parse_classes).transpose()?,
     };
-    if args.samples < 10 {
-        bail!("--samples {}: at least 10 are needed", args.samples);
-    }
     let job = UpdateJob::new(&model, &observations, &settings)?;
+    if args.classes.is_some() && job.alphas().is_empty() {
+        bail!(
+            "--classes is not used with these observations: {} has no poles, and the cut \
+             likelihood (004) has no model classes",
+            args.observations.display()
+        );
+    }
+    crate::validate::observation_work_size(&model, &observations, &args.observations)?;
     let options = SamplerOptions {
         sampler: match args.sampler {
             SamplerArg::Itmcmc => Sampler::Itmcmc,
@@ -131,11 +168,11 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             );
         }
     }
-    write_outputs(&args.out, &result, &model)
+    write_outputs(folder, &result, &model)
 }
 
 fn write_outputs(
-    out: &Path,
+    mut out: Folder,
     r: &UpdateResult,
     nominal: &chatter_dynamics::ModalModel,
 ) -> Result<()> {
@@ -145,7 +182,7 @@ fn write_outputs(
         let row: Vec<String> = s.iter().map(|v| format!("{v:e}")).collect();
         csv += &format!("{},{w:e}\n", row.join(","));
     }
-    write_atomic(&out.join("posterior.csv"), csv.as_bytes())?;
+    out.add("posterior.csv", csv);
     let n = r.posterior_covariance.nrows();
     let covariance: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| r.posterior_covariance[(i, j)]).collect())
@@ -157,21 +194,19 @@ fn write_outputs(
         "classes": r.classes,
         "selected_alpha": r.selected_alpha,
     });
-    write_atomic(
-        &out.join("summary.json"),
-        (serde_json::to_string_pretty(&summary)? + "\n").as_bytes(),
-    )?;
+    out.add(
+        "summary.json",
+        serde_json::to_string_pretty(&summary)? + "\n",
+    );
     let name = format!(
         "{} (updated: posterior mean)",
         nominal.name().unwrap_or("model")
     );
     let updated = r.updated_model.with_name(Some(name));
-    write_atomic(
-        &out.join("updated_model.json"),
-        (updated.to_json_string() + "\n").as_bytes(),
-    )?;
-    evidence_plot(&out.join("evidence.svg"), r)?;
-    corner_plot(&out.join("corner.svg"), r)
+    out.add("updated_model.json", updated.to_json_string() + "\n");
+    out.add("evidence.svg", evidence_plot(r)?);
+    out.add("corner.svg", corner_plot(r)?);
+    out.commit().map(drop)
 }
 
 fn plot_err(e: impl std::fmt::Display) -> anyhow::Error {
@@ -184,7 +219,7 @@ fn padded(lo: f64, hi: f64) -> (f64, f64) {
 }
 
 /// Log-evidence against log2(alpha) (000 Fig. 4a).
-fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
+fn evidence_plot(r: &UpdateResult) -> Result<String> {
     let pts: Vec<(f64, f64)> = r
         .classes
         .iter()
@@ -229,11 +264,11 @@ fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
         }
         root.present().map_err(plot_err)?;
     }
-    write_atomic(path, svg.as_bytes())
+    Ok(svg)
 }
 
 /// Histograms on the diagonal, pairwise scatter below it (000 Fig. 5).
-fn corner_plot(path: &Path, r: &UpdateResult) -> Result<()> {
+fn corner_plot(r: &UpdateResult) -> Result<String> {
     let d = r.parameter_names.len();
     let samples = r.samples.samples();
     let ranges: Vec<(f64, f64)> = (0..d)
@@ -314,5 +349,5 @@ fn corner_plot(path: &Path, r: &UpdateResult) -> Result<()> {
         }
         root.present().map_err(plot_err)?;
     }
-    write_atomic(path, svg.as_bytes())
+    Ok(svg)
 }

@@ -609,7 +609,7 @@ fn plan_prints_the_next_cut() {
                 .arg("--observations")
                 .arg(example("ebrahimi2025_milling_observations.json"))
         )
-        .contains("p_test")
+        .contains("--p-test 1.5")
     );
 }
 
@@ -821,7 +821,7 @@ fn fit_frf_writes_a_model_and_a_plot_for_the_real_tap_test() {
             .args(["--fmin-hz", "3500", "--fmax-hz", "300", "--out"])
             .arg(&out),
     );
-    assert!(err.contains("fmax_hz"), "{err}");
+    assert!(err.contains("--fmax-hz 300"), "{err}");
 }
 
 /// `chatter detect` on two records written by `chatter simulate` (seed 001's milling example at

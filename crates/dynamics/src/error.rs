@@ -6,7 +6,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum DynamicsError {
     /// A value is outside its physical range.
-    #[error("invalid value for `{field}`: {value} ({expected})")]
+    #[error("invalid value for `{field}`: {} (expected {expected})", crate::limits::written(*value))]
     InvalidValue {
         /// The field, in the file format's words (e.g. `modes[1].damping_ratio`).
         field: String,
@@ -24,7 +24,7 @@ pub enum DynamicsError {
         message: String,
     },
     /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{}: {source}", path.display())]
     Io {
         /// The file concerned.
         path: PathBuf,
@@ -32,7 +32,7 @@ pub enum DynamicsError {
         source: std::io::Error,
     },
     /// A file could not be parsed (JSON or CSV syntax, unknown or missing field, wrong type).
-    #[error("{path}: {message}")]
+    #[error("{}: {message}", path.display())]
     Parse {
         /// The file concerned.
         path: PathBuf,
@@ -40,7 +40,7 @@ pub enum DynamicsError {
         message: String,
     },
     /// A file parsed but its content is invalid.
-    #[error("{path}: {error}")]
+    #[error("{}: {error}", path.display())]
     InFile {
         /// The file concerned.
         path: PathBuf,

@@ -3,6 +3,7 @@
 //! field and what was expected.
 
 use crate::error::{DynamicsError, Result};
+use crate::limits;
 use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
 use crate::operation::{Milling, MillingDirection, Operation, Turning};
 use serde::{Deserialize, Serialize};
@@ -326,10 +327,108 @@ impl ModeFile {
     }
 }
 
+impl OperationFile {
+    /// Plausible values in the file's units ([`crate::limits`]).
+    fn check_plausible(&self) -> Result<()> {
+        if let Some(t) = self.teeth
+            && !(1..=limits::MAX_TEETH).contains(&t)
+        {
+            return Err(DynamicsError::invalid(
+                "operation.teeth",
+                format!(
+                    "{t}: expected a number of teeth from 1 to {}",
+                    limits::MAX_TEETH
+                ),
+            ));
+        }
+        if let Some(r) = self.radial_immersion {
+            limits::RADIAL_IMMERSION.check("operation.radial_immersion", r)?;
+        }
+        limits::TOOL_DIAMETER_MM
+            .check_optional("operation.tool_diameter_mm", self.tool_diameter_mm)?;
+        limits::HELIX_DEG.check_optional("operation.helix_deg", self.helix_deg)?;
+        limits::WORKPIECE_DIAMETER_MM.check_optional(
+            "operation.workpiece_diameter_mm",
+            self.workpiece_diameter_mm,
+        )
+    }
+}
+
+impl CuttingFile {
+    /// Plausible values in the file's units ([`crate::limits`]).
+    fn check_plausible(&self) -> Result<()> {
+        limits::CUTTING_COEFFICIENT_N_PER_MM2
+            .check_optional("cutting.kt_n_per_mm2", self.kt_n_per_mm2)?;
+        limits::NORMAL_COEFFICIENT_N_PER_MM2
+            .check_optional("cutting.kn_n_per_mm2", self.kn_n_per_mm2)?;
+        limits::CUTTING_COEFFICIENT_N_PER_MM2
+            .check_optional("cutting.ks_n_per_mm2", self.ks_n_per_mm2)?;
+        limits::BETA_DEG.check_optional("cutting.beta_deg", self.beta_deg)
+    }
+}
+
+impl ModeFile {
+    /// Plausible values in the file's units ([`crate::limits`]): frequency, damping, stiffness,
+    /// and for a mass-normalized shape the stiffness omega^2 / phi^2 it implies at every
+    /// coordinate it moves.
+    fn check_plausible(&self, index: usize) -> Result<()> {
+        let field = |f: &str| format!("modes[{index}].{f}");
+        limits::FREQUENCY_HZ.check(field("frequency_hz"), self.frequency_hz)?;
+        limits::DAMPING_RATIO.check(field("damping_ratio"), self.damping_ratio)?;
+        limits::STIFFNESS_N_PER_M
+            .check_optional(field("stiffness_n_per_m"), self.stiffness_n_per_m)?;
+        let omega = 2.0 * std::f64::consts::PI * self.frequency_hz;
+        for (name, &phi) in self.shape.iter().flatten() {
+            if phi == 0.0 {
+                continue;
+            }
+            let k = omega * omega / (phi * phi);
+            if !limits::STIFFNESS_N_PER_M.contains(k) {
+                return Err(DynamicsError::value(
+                    field(&format!("shape.{name}")),
+                    phi,
+                    format!(
+                        "a mass-normalized component (1/sqrt(kg)) whose stiffness \
+                         (2 pi frequency_hz)^2 / shape^2, here {} N/m, is {}",
+                        limits::written(k),
+                        limits::STIFFNESS_N_PER_M.expected()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl ModelFile {
+    /// Every number against its plausible range in the file's units, and no mode given twice.
+    fn check_plausible(&self) -> Result<()> {
+        self.operation.check_plausible()?;
+        self.cutting.check_plausible()?;
+        for (i, m) in self.modes.iter().enumerate() {
+            m.check_plausible(i)?;
+            if let Some(j) = self.modes[..i].iter().position(|earlier| earlier == m) {
+                return Err(DynamicsError::invalid(
+                    format!("modes[{i}]"),
+                    format!(
+                        "repeats modes[{j}] ({} Hz, damping ratio {}): a mode given twice doubles \
+                         its flexibility; remove one, or give them different directions or shapes",
+                        limits::written(m.frequency_hz),
+                        limits::written(m.damping_ratio)
+                    ),
+                ));
+            }
+        }
+        if let Some(p) = &self.process_damping {
+            limits::PROCESS_DAMPING_N_PER_M.check("process_damping.c_n_per_m", p.c_n_per_m)?;
+        }
+        Ok(())
+    }
+
     /// The validated operation and cutting coefficients alone (what a measured-FRF model needs
     /// besides its receptances).
     pub fn validate_process(&self) -> Result<(Operation, CuttingCoefficients)> {
+        self.check_plausible()?;
         Ok((self.operation.validate()?, self.cutting.validate()?))
     }
 
@@ -436,6 +535,20 @@ impl ModelFile {
     }
 }
 
+/// What a JSON text holds at the top level when it is not an object ("an array", "a number",
+/// ...), from its first character; None for an object or text that is not JSON at all (the
+/// parser names that).
+pub(crate) fn non_object(text: &str) -> Option<&'static str> {
+    match text.trim_start().chars().next()? {
+        '[' => Some("a JSON array"),
+        '"' => Some("a JSON string"),
+        '-' | '0'..='9' => Some("a JSON number"),
+        't' | 'f' => Some("a JSON boolean"),
+        'n' => Some("JSON null"),
+        _ => None,
+    }
+}
+
 impl ModalModel {
     /// Parse and validate a model from JSON text; `origin` names the source in errors.
     pub fn from_json_str(text: &str, origin: &Path) -> Result<Self> {
@@ -443,6 +556,15 @@ impl ModalModel {
             return Err(DynamicsError::Parse {
                 path: origin.to_path_buf(),
                 message: "empty file: expected a JSON model object".into(),
+            });
+        }
+        if let Some(kind) = non_object(text) {
+            return Err(DynamicsError::Parse {
+                path: origin.to_path_buf(),
+                message: format!(
+                    "the file holds {kind}; expected a JSON model object {{\"operation\": ..., \
+                     \"cutting\": ..., \"modes\": [...]}}"
+                ),
             });
         }
         let file: ModelFile = serde_json::from_str(text).map_err(|e| DynamicsError::Parse {

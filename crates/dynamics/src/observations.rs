@@ -2,6 +2,7 @@
 //! records, plus cutting-test tables as CSV (`speed_rpm,depth_mm,stable,chatter_hz[,sequence]`).
 
 use crate::error::{DynamicsError, Result};
+use crate::limits;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -138,36 +139,78 @@ pub struct Observations {
 const QUANTITIES: [&str; 4] = ["acceleration", "velocity", "displacement", "sound"];
 
 fn check_speed_depth(section: &str, i: usize, speed_rpm: f64, depth_mm: f64) -> Result<()> {
-    if !(speed_rpm.is_finite() && speed_rpm > 0.0) {
-        return Err(DynamicsError::value(
-            format!("{section}[{i}].speed_rpm"),
-            speed_rpm,
-            "a spindle speed > 0 rpm",
-        ));
-    }
-    if !(depth_mm.is_finite() && depth_mm > 0.0) {
-        return Err(DynamicsError::value(
-            format!("{section}[{i}].depth_mm"),
-            depth_mm,
-            "a depth > 0 mm",
-        ));
-    }
+    limits::SPEED_RPM.check(format!("{section}[{i}].speed_rpm"), speed_rpm)?;
+    limits::DEPTH_MM.check(format!("{section}[{i}].depth_mm"), depth_mm)?;
     Ok(())
 }
 
 fn check_immersion(section: &str, i: usize, r: Option<f64>) -> Result<()> {
-    match r {
-        Some(r) if !(r.is_finite() && r > 0.0 && r <= 1.0) => Err(DynamicsError::value(
-            format!("{section}[{i}].radial_immersion"),
-            r,
-            "a fraction of the diameter in (0, 1]",
-        )),
-        _ => Ok(()),
+    limits::RADIAL_IMMERSION.check_optional(format!("{section}[{i}].radial_immersion"), r)
+}
+
+impl PoleObservation {
+    /// Ranges of entry `i` ([`crate::limits`]): a pole from a stable cut is damped
+    /// (0 <= zeta < 1) and its standard deviations, which scale the likelihood, are > 0.
+    fn validate(&self, i: usize) -> Result<()> {
+        let field = |f: &str| format!("poles[{i}].{f}");
+        check_speed_depth("poles", i, self.speed_rpm, self.depth_mm)?;
+        check_immersion("poles", i, self.radial_immersion)?;
+        limits::OBSERVED_FREQUENCY_HZ.check(field("frequency_hz"), self.frequency_hz)?;
+        limits::POLE_DAMPING_RATIO.check(field("damping_ratio"), self.damping_ratio)?;
+        limits::STANDARD_DEVIATION
+            .check_optional(field("frequency_std_hz"), self.frequency_std_hz)?;
+        limits::STANDARD_DEVIATION.check_optional(field("damping_std"), self.damping_std)?;
+        if self.repetitions == Some(0) {
+            return Err(DynamicsError::value(
+                field("repetitions"),
+                0.0,
+                "at least 1 identification",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Whether two entries describe the same identification (same cut, same pole).
+    fn same_as(&self, other: &Self) -> bool {
+        self.speed_rpm == other.speed_rpm
+            && self.depth_mm == other.depth_mm
+            && self.frequency_hz == other.frequency_hz
+            && self.damping_ratio == other.damping_ratio
+            && self.radial_immersion == other.radial_immersion
+    }
+}
+
+/// A validation error of a cuts table with the CSV line (header on line 1) before the entry:
+/// `line 3, cuts[1].depth_mm`.
+fn csv_line(error: DynamicsError) -> DynamicsError {
+    let line = |field: &str| {
+        field
+            .strip_prefix("cuts[")
+            .and_then(|rest| rest.split(']').next())
+            .and_then(|i| i.parse::<usize>().ok())
+            .map_or_else(|| field.to_string(), |i| format!("line {}, {field}", i + 2))
+    };
+    match error {
+        DynamicsError::InvalidValue {
+            field,
+            value,
+            expected,
+        } => DynamicsError::InvalidValue {
+            field: line(&field),
+            value,
+            expected,
+        },
+        DynamicsError::Invalid { field, message } => DynamicsError::Invalid {
+            field: line(&field),
+            message,
+        },
+        other => other,
     }
 }
 
 impl Observations {
-    /// Check every entry; an observations set with no entries at all is an error.
+    /// Check every entry; an observations set with no entries at all is an error, and so is a
+    /// pole given twice (it would count twice in the likelihood).
     pub fn validate(&self) -> Result<()> {
         if self.cuts.is_empty() && self.poles.is_empty() && self.signals.is_empty() {
             return Err(DynamicsError::invalid(
@@ -185,59 +228,27 @@ impl Observations {
                         "given for a stable cut; chatter_hz is only for stable = false",
                     ));
                 }
-                if !(f.is_finite() && f > 0.0) {
-                    return Err(DynamicsError::value(
-                        format!("cuts[{i}].chatter_hz"),
-                        f,
-                        "a frequency > 0 Hz",
-                    ));
-                }
+                limits::OBSERVED_FREQUENCY_HZ.check(format!("cuts[{i}].chatter_hz"), f)?;
             }
         }
         for (i, p) in self.poles.iter().enumerate() {
-            check_speed_depth("poles", i, p.speed_rpm, p.depth_mm)?;
-            check_immersion("poles", i, p.radial_immersion)?;
-            if !(p.frequency_hz.is_finite() && p.frequency_hz > 0.0) {
-                return Err(DynamicsError::value(
-                    format!("poles[{i}].frequency_hz"),
-                    p.frequency_hz,
-                    "a frequency > 0 Hz",
+            p.validate(i)?;
+            if let Some(j) = self.poles[..i].iter().position(|q| q.same_as(p)) {
+                return Err(DynamicsError::invalid(
+                    format!("poles[{i}]"),
+                    format!(
+                        "repeats poles[{j}] (same speed, depth, frequency and damping): a pole \
+                         given twice counts twice; give repeated identifications as one entry \
+                         with `frequency_std_hz`, `damping_std` and `repetitions`"
+                    ),
                 ));
-            }
-            if !(p.damping_ratio.is_finite() && p.damping_ratio > -1.0 && p.damping_ratio < 1.0) {
-                return Err(DynamicsError::value(
-                    format!("poles[{i}].damping_ratio"),
-                    p.damping_ratio,
-                    "a damping ratio in (-1, 1)",
-                ));
-            }
-            for (name, v) in [
-                ("frequency_std_hz", p.frequency_std_hz),
-                ("damping_std", p.damping_std),
-            ] {
-                if let Some(v) = v
-                    && !(v.is_finite() && v >= 0.0)
-                {
-                    return Err(DynamicsError::value(
-                        format!("poles[{i}].{name}"),
-                        v,
-                        "a standard deviation >= 0",
-                    ));
-                }
             }
         }
         for (i, s) in self.signals.iter().enumerate() {
             check_speed_depth("signals", i, s.speed_rpm, s.depth_mm)?;
             check_immersion("signals", i, s.radial_immersion)?;
-            if let Some(fs) = s.sample_rate_hz
-                && !(fs.is_finite() && fs > 0.0)
-            {
-                return Err(DynamicsError::value(
-                    format!("signals[{i}].sample_rate_hz"),
-                    fs,
-                    "a sample rate > 0 Hz",
-                ));
-            }
+            limits::SAMPLE_RATE_HZ
+                .check_optional(format!("signals[{i}].sample_rate_hz"), s.sample_rate_hz)?;
             if let Some(q) = &s.quantity
                 && !QUANTITIES.contains(&q.as_str())
             {
@@ -250,6 +261,61 @@ impl Observations {
         Ok(())
     }
 
+    /// Whether these observations can come from the operation of `model`: a turning model
+    /// takes no `radial_immersion` (a milling quantity), and a milling pole's `frequency_hz` is
+    /// the principal frequency of the multiplier lifted at the tooth period, so it lies in
+    /// [0, f_tp / 2] with f_tp the tooth-passing frequency (002 Section 2.1); a larger value is a
+    /// physical frequency, as turning observations give.
+    pub fn check_against(&self, model: &crate::ModalModel) -> Result<()> {
+        let immersions = self
+            .cuts
+            .iter()
+            .map(|c| ("cuts", c.radial_immersion))
+            .chain(self.poles.iter().map(|p| ("poles", p.radial_immersion)))
+            .chain(self.signals.iter().map(|s| ("signals", s.radial_immersion)));
+        match model.operation() {
+            crate::Operation::Turning(_) => {
+                let mut index = std::collections::BTreeMap::<&str, usize>::new();
+                for (section, r) in immersions {
+                    let i = index.entry(section).or_default();
+                    if r.is_some() {
+                        return Err(DynamicsError::invalid(
+                            format!("{section}[{i}].radial_immersion"),
+                            "a milling quantity, but the model is turning: are these milling \
+                             observations?",
+                        ));
+                    }
+                    *i += 1;
+                }
+            }
+            crate::Operation::Milling(m) => {
+                for (i, p) in self.poles.iter().enumerate() {
+                    let half_tooth_passing_hz = p.speed_rpm / 60.0 * m.teeth() as f64 / 2.0;
+                    // 10 % slack: a principal frequency near the edge plus identification
+                    // scatter; a physical frequency is many times above it
+                    if p.frequency_hz > 1.1 * half_tooth_passing_hz {
+                        return Err(DynamicsError::value(
+                            format!("poles[{i}].frequency_hz"),
+                            p.frequency_hz,
+                            format!(
+                                "for the {}-tooth milling model a principal frequency of the \
+                                 lifted multiplier, at most half the tooth-passing frequency \
+                                 ({} Hz at {} rpm); a physical frequency like this one comes \
+                                 from turning observations or an OMA without the milling model",
+                                m.teeth(),
+                                crate::limits::written(
+                                    (half_tooth_passing_hz * 100.0).round() / 100.0
+                                ),
+                                crate::limits::written(p.speed_rpm)
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Parse and validate observations from JSON text; `origin` names the source in errors and
     /// its folder resolves signal files.
     pub fn from_json_str(text: &str, origin: &Path) -> Result<Self> {
@@ -257,6 +323,15 @@ impl Observations {
             return Err(DynamicsError::Parse {
                 path: origin.to_path_buf(),
                 message: "empty file: expected a JSON observations object".into(),
+            });
+        }
+        if let Some(kind) = crate::model_file::non_object(text) {
+            return Err(DynamicsError::Parse {
+                path: origin.to_path_buf(),
+                message: format!(
+                    "the file holds {kind}; expected a JSON observations object {{\"cuts\": \
+                     [...], \"poles\": [...], \"signals\": [...]}}"
+                ),
             });
         }
         let mut obs: Observations =
@@ -371,12 +446,49 @@ impl Observations {
             cuts,
             ..Default::default()
         };
-        obs.validate().map_err(|e| e.in_file(origin))?;
+        obs.validate().map_err(|e| csv_line(e).in_file(origin))?;
         Ok(obs)
     }
 
     /// Pretty JSON in the formats-spec shape.
     pub fn to_json_string(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::examples;
+
+    #[test]
+    fn observations_are_checked_against_the_operation_of_the_model() {
+        let turning = examples::ahmadi_2022_turning_observations();
+        let milling = examples::ebrahimi_2025_milling_observations();
+        assert!(
+            turning
+                .check_against(&examples::ahmadi_2022_turning())
+                .is_ok()
+        );
+        assert!(
+            milling
+                .check_against(&examples::ebrahimi_2025_milling())
+                .is_ok()
+        );
+        // 2473 Hz at 7150 rpm is far above half the tooth-passing frequency of 4 teeth (238 Hz)
+        let e = turning
+            .check_against(&examples::schmitz_2023_milling())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("poles[0].frequency_hz") && e.contains("2473"),
+            "{e}"
+        );
+        let mut with_immersion = milling.clone();
+        with_immersion.cuts[0].radial_immersion = Some(0.5);
+        let e = with_immersion
+            .check_against(&examples::ahmadi_2022_turning())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("cuts[0].radial_immersion"), "{e}");
     }
 }

@@ -170,6 +170,9 @@ pub const STEPS_PER_MODE_PERIOD: f64 = 100.0;
 pub const MIN_STEPS_PER_TOOTH: usize = 2000;
 /// Fewest internal steps per delay in turning (continuous cutting).
 pub const MIN_STEPS_PER_DELAY: usize = 50;
+/// Most surface samples (internal steps per delay times cutting edges) the simulator keeps: the
+/// surface of the previous pass is a ring buffer of this length (8 bytes each, 400 MB at most).
+pub const MAX_SURFACE_SAMPLES: usize = 50_000_000;
 
 /// Per mode: transition (row-major 2x2), input vector of the held force, input vector of the
 /// force's change over the step, shape, omega_n, zeta_n.
@@ -239,6 +242,26 @@ pub fn simulate_with_observer(
         Operation::Milling(_) => MIN_STEPS_PER_TOOTH,
     };
     let (h, steps_per_delay) = internal_step(f_max, tau, min_steps);
+    let edges = match model.operation() {
+        Operation::Turning(_) => 1,
+        Operation::Milling(m) => m.teeth(),
+    };
+    let surface_samples = steps_per_delay.saturating_mul(edges);
+    if surface_samples > MAX_SURFACE_SAMPLES {
+        // steps per delay grow as 1 / speed: the speed at which the surface fits the cap
+        let lowest = settings.speed_rpm * surface_samples as f64 / MAX_SURFACE_SAMPLES as f64;
+        return Err(DynamicsError::value(
+            "speed_rpm",
+            settings.speed_rpm,
+            format!(
+                "a speed whose delay the simulator resolves in at most {MAX_SURFACE_SAMPLES} \
+                 surface samples (one delay needs {surface_samples} here at {STEPS_PER_MODE_PERIOD} \
+                 steps per period of the {} Hz mode); a speed above {} rpm",
+                crate::limits::written(f_max),
+                crate::limits::written(lowest.ceil())
+            ),
+        ));
+    }
     let n_out = (settings.duration_s * settings.sample_rate_hz).floor() as usize;
     let mut resampler = Resampler::<2>::new(h, settings.sample_rate_hz);
     let last_out_s = (n_out.max(1) - 1) as f64 / settings.sample_rate_hz;

@@ -221,3 +221,82 @@ proptest! {
         prop_assert_eq!(same, model);
     }
 }
+
+/// The example files of the repository (models and observations).
+fn example_texts() -> Vec<(String, bool)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    [
+        ("schmitz2023_milling_model.json", true),
+        ("ahmadi2022_turning_model.json", true),
+        ("ebrahimi2025_milling_model.json", true),
+        ("ahmadi2022_turning_observations.json", false),
+        ("ebrahimi2025_milling_observations.json", false),
+    ]
+    .iter()
+    .map(|(name, model)| (std::fs::read_to_string(dir.join(name)).unwrap(), *model))
+    .collect()
+}
+
+/// Byte ranges of the JSON numbers in `text`.
+fn number_spans(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts = bytes[i].is_ascii_digit() || bytes[i] == b'-';
+        let after_colon = text[..i].trim_end().ends_with(':')
+            || text[..i].trim_end().ends_with(',')
+            || text[..i].trim_end().ends_with('[');
+        if starts && after_colon {
+            let start = i;
+            while i < bytes.len() && (bytes[i].is_ascii_digit() || b"-+.eE".contains(&bytes[i])) {
+                i += 1;
+            }
+            spans.push((start, i));
+        } else {
+            i += 1;
+        }
+    }
+    spans
+}
+
+const NASTY: [&str; 16] = [
+    "0", "-0", "-1", "1e300", "-1e300", "1e-300", "1e16", "0.5", "2.5", "1", "400", "true", "null",
+    "[]", "\"x\"", "{}",
+];
+
+proptest! {
+    /// Random edits of the example files (a number replaced by a nasty value, or a byte cut)
+    /// never panic, and whatever is accepted has finite receptances.
+    #[test]
+    fn random_edits_of_the_examples_never_panic(
+        file in 0usize..5,
+        picks in proptest::collection::vec((any::<proptest::sample::Index>(), 0usize..NASTY.len()), 1..4),
+        cut in proptest::option::of(any::<proptest::sample::Index>()),
+    ) {
+        let (mut text, is_model) = example_texts().swap_remove(file);
+        for (index, value) in picks {
+            let spans = number_spans(&text);
+            if spans.is_empty() {
+                break;
+            }
+            let (a, b) = spans[index.index(spans.len())];
+            text.replace_range(a..b, NASTY[value]);
+        }
+        if let Some(at) = cut {
+            let at = at.index(text.len());
+            if text.is_char_boundary(at) {
+                text.remove(at);
+            }
+        }
+        if is_model {
+            if let Ok(model) = ModalModel::from_json_str(&text, Path::new("edited.json")) {
+                for m in model.modes() {
+                    prop_assert!(model.receptance(0.9 * m.frequency_hz(), 0, 0).norm().is_finite());
+                }
+            }
+        } else {
+            let _ = Observations::from_json_str(&text, Path::new("edited.json"));
+        }
+    }
+}

@@ -81,6 +81,24 @@ impl ParameterDistribution {
                 format!("the covariance must be a {d} x {d} matrix (one row per parameter)"),
             ));
         }
+        // a covariance is symmetric: an asymmetric matrix is a typo, not a distribution (the
+        // Cholesky factor would silently read one triangle only); relative tolerance 1e-9 for
+        // values printed with ten significant digits
+        for (i, row) in covariance.iter().enumerate() {
+            for (j, column) in covariance.iter().enumerate().take(i) {
+                let (a, b) = (row[j], column[i]);
+                if !(a.is_finite() && b.is_finite()) || (a - b).abs() > 1e-9 * a.abs().max(b.abs())
+                {
+                    return Err(invalid(
+                        source,
+                        format!(
+                            "covariance[{i}][{j}] = {a:?} but covariance[{j}][{i}] = {b:?}: a \
+                             covariance matrix is symmetric"
+                        ),
+                    ));
+                }
+            }
+        }
         if let Some(bad) = samples
             .as_ref()
             .and_then(|s| s.iter().find(|r| r.len() != d))

@@ -1,0 +1,354 @@
+//! Checks of the command-line options before any work starts: ranges in the units the user
+//! wrote (`--depth-mm -1` is reported as `-1`, not as metres), limits on the work a command may
+//! start (points, samples, steps per delay), options the chosen kind would ignore, and
+//! consistency between the files given together (operation kind, coordinates).
+//!
+//! Ranges of file contents live with their types (`chatter_dynamics::limits`); this module
+//! reuses them for the options that carry the same quantities.
+
+use anyhow::{Result, bail};
+use chatter_dynamics::limits::{Plausible, SPEED_RPM, written};
+use chatter_dynamics::{ModalModel, Observations, Operation};
+use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+
+/// Most cutting steps per delay a discretization may use. The cost of one multiplier grows as
+/// the square of the steps (measured on the seed-000 turning model, debug build: 1 400 steps
+/// 0.5 s, 5 000 steps 2.9 s, 10 000 steps 11 s), and a lobe diagram needs thousands of
+/// multipliers, so beyond this a run is a hang in all but name.
+pub const MAX_STEPS_PER_DELAY: usize = 10_000;
+/// Most frequencies of `chatter frf`.
+pub const MAX_POINTS: usize = 1_000_000;
+/// Most speeds or depths of a `MIN:MAX:N` grid.
+pub const MAX_GRID: usize = 10_000;
+
+/// The option values as typed on the command line, by option name (`speed_rpm`).
+static TYPED: std::sync::OnceLock<std::collections::HashMap<String, String>> =
+    std::sync::OnceLock::new();
+
+/// Keep the values of the subcommand's options as typed, for messages that echo them.
+pub fn remember_typed(matches: &clap::ArgMatches) {
+    let typed = matches
+        .ids()
+        .filter_map(|id| {
+            let raw = matches.get_raw(id.as_str())?;
+            let text: Vec<String> = raw.map(|v| v.to_string_lossy().into_owned()).collect();
+            Some((id.as_str().to_string(), text.join(",")))
+        })
+        .collect();
+    let _ = TYPED.set(typed);
+}
+
+/// The value of option `flag` as the user typed it, else `value` written plainly.
+pub fn as_typed(flag: &str, value: f64) -> String {
+    let id = flag.trim_start_matches('-').replace('-', "_");
+    TYPED
+        .get()
+        .and_then(|t| t.get(&id))
+        .filter(|text| text.trim().parse::<f64>() == Ok(value))
+        .cloned()
+        .unwrap_or_else(|| written(value))
+}
+
+/// `value` of option `flag` when `range` holds it, else an error that echoes it as typed.
+pub fn option(flag: &str, value: f64, range: &Plausible) -> Result<f64> {
+    if range.contains(value) {
+        Ok(value)
+    } else {
+        bail!(
+            "{flag} {}: expected {}",
+            as_typed(flag, value),
+            range.expected()
+        )
+    }
+}
+
+/// A count option within `min..=max`.
+pub fn count(flag: &str, value: usize, min: usize, max: usize, what: &str) -> Result<usize> {
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        bail!("{flag} {value}: expected {what} from {min} to {max}")
+    }
+}
+
+/// A range of plausible values of an option that has no file counterpart.
+pub const fn between(min: f64, max: f64, what: &'static str, unit: &'static str) -> Plausible {
+    Plausible {
+        min,
+        min_included: false,
+        max,
+        max_included: true,
+        what,
+        unit,
+    }
+}
+
+/// Signal length of `chatter simulate`.
+pub const DURATION_S: Plausible = between(0.0, 3600.0, "a signal length", "s");
+/// Feed per tooth (milling) or per revolution (turning).
+pub const FEED_MM: Plausible = between(0.0, 10.0, "a feed", "mm");
+/// RMS or amplitude of a simulated force (zero allowed).
+pub const FORCE_N: Plausible = Plausible {
+    min: 0.0,
+    min_included: true,
+    max: 1e6,
+    max_included: true,
+    what: "a force",
+    unit: "N",
+};
+/// Frequencies of `chatter frf` (zero allowed).
+pub const FRF_HZ: Plausible = Plausible {
+    min: 0.0,
+    min_included: true,
+    max: 1e6,
+    max_included: true,
+    what: "a frequency",
+    unit: "Hz",
+};
+/// Speed offset of the Type B bands.
+pub const OFFSET_RPM: Plausible = Plausible {
+    min: 0.0,
+    min_included: true,
+    max: 1e5,
+    max_included: true,
+    what: "a speed offset",
+    unit: "rpm",
+};
+/// Depth offset of the Type B bands.
+pub const OFFSET_MM: Plausible = Plausible {
+    min: 0.0,
+    min_included: true,
+    max: 100.0,
+    max_included: true,
+    what: "a depth offset",
+    unit: "mm",
+};
+/// Depths of a `--depths` grid (zero allowed as its first value).
+pub const DEPTH_GRID_MM: Plausible = Plausible {
+    min: 0.0,
+    min_included: true,
+    max: 1000.0,
+    max_included: true,
+    what: "a depth of cut",
+    unit: "mm",
+};
+/// Probability of stability of a tested contour.
+pub const PROBABILITY: Plausible = Plausible {
+    min: 0.0,
+    min_included: false,
+    max: 1.0,
+    max_included: false,
+    what: "a probability",
+    unit: "",
+};
+
+/// Most output samples of `chatter simulate` (duration times sample rate).
+pub const MAX_SIMULATED_SAMPLES: f64 = 1e8;
+
+/// The simulated signal is at least 2 and at most [`MAX_SIMULATED_SAMPLES`] samples long.
+pub fn simulation_length(duration_s: f64, sample_rate_hz: f64) -> Result<()> {
+    let samples = duration_s * sample_rate_hz;
+    if !(2.0..=MAX_SIMULATED_SAMPLES).contains(&samples) {
+        bail!(
+            "--duration-s {} at --sample-rate-hz {}: {} samples; expected 2 to {} samples",
+            written(duration_s),
+            written(sample_rate_hz),
+            written(samples.floor()),
+            written(MAX_SIMULATED_SAMPLES)
+        );
+    }
+    Ok(())
+}
+
+/// An option given where the chosen kind does not use it.
+pub fn unused(given: bool, flag: &str, context: &str, used_by: &str) -> Result<()> {
+    if given {
+        bail!("{flag} is not used {context}; it is for {used_by}");
+    }
+    Ok(())
+}
+
+/// Parse `MIN:MAX:N` of option `flag` with MIN and MAX in `range` and 2 <= N <= [`MAX_GRID`].
+pub fn grid(flag: &str, spec: &str, range: &Plausible) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = spec.split(':').collect();
+    let [min, max, n] = parts[..] else {
+        bail!("{flag} {spec}: expected MIN:MAX:N, e.g. 3000:15000:200");
+    };
+    let number = |part: &str, name: &str| -> Result<f64> {
+        part.trim()
+            .parse::<f64>()
+            .map_err(|_| anyhow::anyhow!("{flag} {spec}: {name} `{part}` is not a number"))
+    };
+    let (lo, hi) = (number(min, "MIN")?, number(max, "MAX")?);
+    let n: usize = n
+        .trim()
+        .parse()
+        .map_err(|_| anyhow::anyhow!("{flag} {spec}: N `{n}` is not a whole number of points"))?;
+    for (name, v, text) in [("MIN", lo, min), ("MAX", hi, max)] {
+        if !range.contains(v) {
+            bail!(
+                "{flag} {spec}: {name} {}: expected {}",
+                text.trim(),
+                range.expected()
+            );
+        }
+    }
+    if hi <= lo {
+        bail!("{flag} {spec}: expected MIN < MAX");
+    }
+    if !(2..=MAX_GRID).contains(&n) {
+        bail!("{flag} {spec}: N {n}: expected 2 to {MAX_GRID} points");
+    }
+    Ok((0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect())
+}
+
+/// `--speeds MIN:MAX:N` within the plausible spindle speeds.
+pub fn speeds(spec: &str) -> Result<Vec<f64>> {
+    grid("--speeds", spec, &SPEED_RPM)
+}
+
+/// Refuse speeds at which `method` would need more than [`MAX_STEPS_PER_DELAY`] steps per delay
+/// (the step count grows as 1 / speed); `source` names where the speeds came from.
+pub fn work_size(
+    model: &ModalModel,
+    method: Discretization,
+    speeds: &[f64],
+    source: &str,
+) -> Result<()> {
+    let Some(&slowest) = speeds.iter().min_by(|a, b| a.total_cmp(b)) else {
+        return Ok(());
+    };
+    let resolved = method.resolved(model, slowest)?;
+    let StepsPerDelay::Fixed(steps) = resolved.steps else {
+        return Ok(());
+    };
+    if steps > MAX_STEPS_PER_DELAY {
+        // steps per delay scale as 1 / speed
+        let lowest = slowest * steps as f64 / MAX_STEPS_PER_DELAY as f64;
+        bail!(
+            "{source}: at {} rpm one delay needs {steps} steps of the discretization (at most \
+             {MAX_STEPS_PER_DELAY}): give speeds of at least {} rpm, or use --method zoa where \
+             the command offers it",
+            written(slowest),
+            written(lowest.ceil())
+        );
+    }
+    Ok(())
+}
+
+/// [`work_size`] at the speeds of the observations' cuts and poles, for the commands that
+/// evaluate the model there with the automatic full discretization.
+pub fn observation_work_size(
+    model: &ModalModel,
+    observations: &Observations,
+    path: &std::path::Path,
+) -> Result<()> {
+    let speeds: Vec<f64> = observations
+        .cuts
+        .iter()
+        .map(|c| c.speed_rpm)
+        .chain(observations.poles.iter().map(|p| p.speed_rpm))
+        .collect();
+    work_size(
+        model,
+        Discretization::full(),
+        &speeds,
+        &format!("{} (observed speeds)", path.display()),
+    )
+}
+
+/// The model and the observations describe the same operation (see
+/// [`Observations::check_against`]), with the file names in the message.
+pub fn observations_match(
+    model: &ModalModel,
+    observations: &Observations,
+    observations_path: &std::path::Path,
+    model_path: &std::path::Path,
+) -> Result<()> {
+    observations.check_against(model).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: {e} (model {})",
+            observations_path.display(),
+            model_path.display()
+        )
+    })
+}
+
+/// The operation of a model in words.
+fn kind(model: &ModalModel) -> &'static str {
+    match model.operation() {
+        Operation::Milling(_) => "milling",
+        Operation::Turning(_) => "turning",
+    }
+}
+
+/// A posterior folder of `chatter update` belongs to `model`: its `updated_model.json` has the
+/// same operation and number of modes (the parameters name modes by number).
+pub fn posterior_matches(model: &ModalModel, dir: &std::path::Path) -> Result<()> {
+    let path = dir.join("updated_model.json");
+    if !path.is_file() {
+        return Ok(());
+    }
+    let updated = ModalModel::from_path(&path)
+        .map_err(|e| anyhow::anyhow!("--posterior {}: {e}", dir.display()))?;
+    if kind(&updated) != kind(model) || updated.mode_count() != model.mode_count() {
+        bail!(
+            "--posterior {}: the posterior comes from a {} model with {} modes ({}), but \
+             --model is a {} model with {} modes; give the model the posterior was updated on",
+            dir.display(),
+            kind(&updated),
+            updated.mode_count(),
+            path.display(),
+            kind(model),
+            model.mode_count()
+        );
+    }
+    Ok(())
+}
+
+/// The channels of a signal record are the model's coordinates, not the other operation's (a
+/// turning record has `feed`/`cutting`, a milling one `x`/`y`).
+pub fn channels_match(model: &ModalModel, names: &[String], record: &str) -> Result<()> {
+    let (own, other) = match model.operation() {
+        Operation::Milling(_) => (["x", "y"], ["feed", "cutting"]),
+        Operation::Turning(_) => (["feed", "cutting"], ["x", "y"]),
+    };
+    let kind = kind(model);
+    if let Some(name) = names.iter().find(|n| other.contains(&n.as_str())) {
+        bail!(
+            "{record}: channel `{name}` is a coordinate of the other operation, but the model is \
+             {kind} (coordinates {own:?}); is this record from another machine?"
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_errors_echo_the_spec() {
+        let e = speeds("0.001:0.01:2").unwrap_err().to_string();
+        assert!(
+            e.contains("--speeds 0.001:0.01:2") && e.contains("MIN 0.001"),
+            "{e}"
+        );
+        let e = speeds("1e9:2e9:5").unwrap_err().to_string();
+        assert!(e.contains("MIN 1e9:"), "{e}");
+        assert_eq!(speeds("1000:2000:3").unwrap(), vec![1000.0, 1500.0, 2000.0]);
+    }
+
+    #[test]
+    fn option_echoes_the_value_as_written() {
+        let e = option("--depth-mm", -1.0, &chatter_dynamics::limits::DEPTH_MM)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("--depth-mm -1: expected a depth of cut"),
+            "{e}"
+        );
+    }
+}
