@@ -11,7 +11,7 @@ use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
 use chatter_uncertainty::montecarlo::{FailureKind, sample_boundaries};
 use chatter_uncertainty::parameters::ParameterDistribution;
-use chatter_uncertainty::perturbation::model_moment_grid;
+use chatter_uncertainty::perturbation::{BoundRule, model_moment_grid};
 use plotters::style::{BLUE, GREEN, RGBColor};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -49,6 +49,8 @@ pub struct BandRequest<'a> {
     pub samples: usize,
     /// Seed of the Monte Carlo draws.
     pub seed: u64,
+    /// Perturbation bounds of this central credibility of |mu| (None: |E mu| +- sd).
+    pub coverage: Option<f64>,
     /// Observed cuts.
     pub observations: Option<&'a Path>,
     /// CSV destination (stdout when absent).
@@ -194,17 +196,21 @@ fn perturbation(
     speeds: &[f64],
     obs: Option<&Observations>,
 ) -> Result<()> {
+    let rule = match req.coverage {
+        Some(c) => BoundRule::coverage(c).map_err(|e| anyhow::anyhow!("--coverage: {e}"))?,
+        None => BoundRule::ComplexSd,
+    };
     let dist = distribution(req)?;
     let method = discretization(req)?;
     let mean_model = dist.mean_model(model)?;
     let mean_lobes = compute_lobes(&mean_model, req.method.unwrap_or(Method::Fdm), speeds, true)?;
     let depths = depth_grid(req, &mean_lobes)?;
-    let (csv, series) = credibility_bands(&mean_model, &dist, method, speeds, &depths)?;
+    let (csv, series) = credibility_bands(&mean_model, &dist, method, rule, speeds, &depths)?;
     emit(req.out, &csv)?;
     if let Some(path) = req.plot {
         line_chart(
             path,
-            "Second-order perturbation credibility bounds",
+            &format!("Credibility bounds at the posterior mean: {}", rule_title(rule)),
             "spindle speed (rpm)",
             "depth (mm)",
             &series,
@@ -214,13 +220,23 @@ fn perturbation(
     Ok(())
 }
 
+/// Plot title of a bound rule.
+pub fn rule_title(rule: BoundRule) -> String {
+    match rule {
+        BoundRule::ComplexSd => "|E mu| +- 1 sd of complex mu (000 Sec. 6.4)".into(),
+        BoundRule::Coverage(c) => format!("{:.0} % credibility of |mu|", 100.0 * c),
+    }
+}
+
 /// Credibility bounds of the model at the distribution's mean (000 Eq. 14-18 with the covariance
-/// about the mean) on a speed x depth grid: CSV `speed_rpm,depth_mm,lower_mm,upper_mm` and the
-/// plot series.
+/// about the mean) on a speed x depth grid under `rule`: CSV
+/// `speed_rpm,depth_mm,lower_mm,upper_mm` (empty cells where a contour is not reached on the
+/// grid) and the plot series, broken (NaN) at those speeds so no line is drawn across a gap.
 pub fn credibility_bands(
     mean_model: &ModalModel,
     dist: &ParameterDistribution,
     method: chatter_stability::monodromy::Discretization,
+    rule: BoundRule,
     speeds: &[f64],
     depths: &[f64],
 ) -> Result<(String, [Series; 3])> {
@@ -232,7 +248,7 @@ pub fn credibility_bands(
         speeds,
         depths,
     )?;
-    let bounds = grid.bounds();
+    let bounds = grid.bounds(rule);
     let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm\n");
     for b in &bounds {
         let _ = writeln!(
@@ -247,18 +263,29 @@ pub fn credibility_bands(
     let pick = |f: fn(&chatter_uncertainty::perturbation::CredibilityPoint) -> Option<f64>| {
         bounds
             .iter()
-            .filter_map(|b| f(b).map(|d| (b.speed_rpm, d)))
+            .map(|b| (b.speed_rpm, f(b).unwrap_or(f64::NAN)))
             .collect::<Vec<_>>()
+    };
+    let (mean, lower, upper) = match rule {
+        BoundRule::ComplexSd => (
+            "mean |E mu| = 1".to_string(),
+            "lower: |E mu| + sd = 1".to_string(),
+            "upper: |E mu| - sd = 1".to_string(),
+        ),
+        BoundRule::Coverage(c) => {
+            let p = 100.0 * c;
+            (
+                "mean E|mu| = 1".to_string(),
+                format!("lower ({p:.0} %)"),
+                format!("upper ({p:.0} %)"),
+            )
+        }
     };
     let series = band_series(
         pick(|b| b.depth_mm),
         pick(|b| b.lower_mm),
         pick(|b| b.upper_mm),
-        [
-            "mean |mu| = 1",
-            "|E mu| + sd = 1 (lower)",
-            "|E mu| - sd = 1 (upper)",
-        ],
+        [&mean, &lower, &upper],
     );
     Ok((csv, series))
 }

@@ -13,6 +13,7 @@ mod plan;
 mod plot;
 mod progress;
 mod rcsa;
+mod sensitivity;
 mod update;
 
 use bands::BandKind;
@@ -145,6 +146,10 @@ enum Command {
         /// Seed of the Monte Carlo draws.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Perturbation: bounds of this central credibility of |mu| (e.g. 0.95) instead of the
+        /// paper's |E mu| +- one standard deviation of the complex mu.
+        #[arg(long)]
+        coverage: Option<f64>,
         /// Observed cuts to draw.
         #[arg(long)]
         observations: Option<PathBuf>,
@@ -219,6 +224,9 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Sensitivity |d mu / d theta| of the dominant pole at one cut (000 Table 3) as JSON, on
+    /// the one-step map of the full discretization (or the period map).
+    Sensitivity(sensitivity::SensitivityArgs),
     /// Bayesian model updating: posterior.csv, summary.json, updated_model.json, evidence and
     /// corner plots in --out.
     Update(update::UpdateArgs),
@@ -321,6 +329,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             covariance,
             samples,
             seed,
+            coverage,
             observations,
             out,
             map_out,
@@ -336,6 +345,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             covariance: covariance.as_deref(),
             samples,
             seed,
+            coverage,
             observations: observations.as_deref(),
             out: out.as_deref(),
             map_out: map_out.as_deref(),
@@ -391,6 +401,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out: out.as_deref(),
             quiet,
         }),
+        Command::Sensitivity(args) => sensitivity::run(&args),
         Command::Update(args) => update::run(&args, quiet),
         Command::Plan(args) => plan::run(&args, quiet),
         Command::Detect(args) => detect::run(&args),

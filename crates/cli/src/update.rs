@@ -48,12 +48,29 @@ pub struct UpdateArgs {
     /// Samples per class.
     #[arg(long, default_value_t = 5000)]
     samples: usize,
+    /// Milling poles (002): `gp` replaces the exact monodromy eigenvalues by the Matérn GP
+    /// surrogate of 002 Section 2.2, trained on the exact model over the prior box; `exact`
+    /// computes them for every sample. Default: gp for milling poles (the only data it applies to).
+    #[arg(long, value_enum)]
+    surrogate: Option<SurrogateArg>,
+    /// Training points of the GP surrogate (Halton points of the prior box).
+    #[arg(long, default_value_t = chatter_updating::surrogate::DEFAULT_TRAINING_POINTS)]
+    surrogate_points: usize,
     /// Seed.
     #[arg(long)]
     seed: u64,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
+}
+
+/// Likelihood evaluation of milling poles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SurrogateArg {
+    /// Matérn GP surrogate of the dominant multiplier (002 Section 2.2).
+    Gp,
+    /// The exact monodromy eigenvalue for every sample.
+    Exact,
 }
 
 /// Progress: one step per model class.
@@ -101,7 +118,17 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             .transpose()?,
         priors,
         classes: args.classes.as_deref().map(parse_classes).transpose()?,
+        surrogate_training_points: match args.surrogate {
+            Some(SurrogateArg::Gp) | None => Some(args.surrogate_points),
+            Some(SurrogateArg::Exact) => None,
+        },
     };
+    if args.surrogate_points < 10 {
+        bail!(
+            "--surrogate-points {}: at least 10 are needed",
+            args.surrogate_points
+        );
+    }
     if args.samples < 10 {
         bail!("--samples {}: at least 10 are needed", args.samples);
     }
@@ -131,6 +158,35 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             );
         }
     }
+    if let Some(s) = &result.surrogate {
+        eprintln!(
+            "GP surrogate ({} training points): held-out pole errors rms {:.3} Hz / {:.2e} \
+             damping (max {:.3} Hz / {:.2e}); |ln L error| at {} posterior samples mean {:.3}, \
+             max {:.3}",
+            s.held_out.training_points,
+            s.held_out.rms_frequency_error_hz,
+            s.held_out.rms_damping_error,
+            s.held_out.max_frequency_error_hz,
+            s.held_out.max_damping_error,
+            s.posterior_points,
+            s.mean_abs_ln_likelihood_error,
+            s.max_abs_ln_likelihood_error
+        );
+    }
+    for p in &result.prior_bound_pileups {
+        eprintln!(
+            "warning: {}: {:.0} % of the posterior lies at the {} bound {} of its prior (median \
+             {:.4e}): the prior decides this parameter, not the data; widen it with --priors",
+            p.parameter,
+            100.0 * p.share_at_bound,
+            match p.bound {
+                chatter_updating::prior_bounds::Bound::Lower => "lower",
+                chatter_updating::prior_bounds::Bound::Upper => "upper",
+            },
+            p.bound_value,
+            p.posterior_median
+        );
+    }
     write_outputs(&args.out, &result, &model)
 }
 
@@ -156,6 +212,8 @@ fn write_outputs(
         "posterior_covariance": covariance,
         "classes": r.classes,
         "selected_alpha": r.selected_alpha,
+        "prior_bound_pileups": r.prior_bound_pileups,
+        "surrogate": r.surrogate,
     });
     write_atomic(
         &out.join("summary.json"),
@@ -183,32 +241,55 @@ fn padded(lo: f64, hi: f64) -> (f64, f64) {
     (lo - 0.05 * span, hi + 0.05 * span)
 }
 
-/// Log-evidence against log2(alpha) (000 Fig. 4a).
+/// Model classes against log2(alpha): (a) the log-evidence with the two terms of 000 Eq. 33,
+/// data fit E[ln p(D | theta)] and information gain (Fig. 4a); (b) the class probabilities
+/// p(M | D) of Eq. 32 (Fig. 4b).
 fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
-    let pts: Vec<(f64, f64)> = r
+    let classes: Vec<_> = r
         .classes
         .iter()
-        .filter_map(|c| c.alpha.map(|a| (a.log2(), c.log_evidence)))
-        .filter(|p| p.1.is_finite())
+        .filter_map(|c| c.alpha.map(|a| (a.log2(), c)))
+        .filter(|p| p.1.log_evidence.is_finite())
         .collect();
-    let (x0, x1) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
-        (a.0.min(p.0), a.1.max(p.0))
-    });
-    let (y0, y1) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
-        (a.0.min(p.1), a.1.max(p.1))
-    });
+    let curve = |f: &dyn Fn(&chatter_updating::update::ClassSummary) -> Option<f64>| {
+        classes
+            .iter()
+            .filter_map(|(x, c)| f(c).filter(|v| v.is_finite()).map(|v| (*x, v)))
+            .collect::<Vec<_>>()
+    };
+    let terms = [
+        ("ln p(D | M) (evidence)", curve(&|c| Some(c.log_evidence)), BLUE),
+        ("E[ln p(D | theta, M)] (data fit)", curve(&|c| c.data_fit), GREEN),
+        (
+            "E[ln posterior / prior] (information gain)",
+            curve(&|c| c.information_gain),
+            RED,
+        ),
+    ];
+    let probabilities = curve(&|c| Some(c.probability));
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (800, 500)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (800, 800)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        if pts.is_empty() {
+        if classes.is_empty() {
             root.titled("no model classes (cut likelihood)", ("sans-serif", 20))
                 .map_err(plot_err)?;
         } else {
-            let (x0, x1) = padded(x0, x1);
+            let (top, bottom) = root.split_vertically(480);
+            let (x0, x1) = padded(
+                classes.iter().map(|c| c.0).fold(f64::INFINITY, f64::min),
+                classes.iter().map(|c| c.0).fold(f64::NEG_INFINITY, f64::max),
+            );
+            let ys = terms.iter().flat_map(|t| t.1.iter().map(|p| p.1));
+            let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
+                (a.0.min(y), a.1.max(y))
+            });
             let (y0, y1) = padded(y0, y1);
-            let mut chart = ChartBuilder::on(&root)
-                .caption("Model evidence per class", ("sans-serif", 20))
+            let mut chart = ChartBuilder::on(&top)
+                .caption(
+                    "(a) Model evidence per class and its two terms (Eq. 33)",
+                    ("sans-serif", 18),
+                )
                 .margin(15)
                 .x_label_area_size(40)
                 .y_label_area_size(70)
@@ -217,14 +298,47 @@ fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
             chart
                 .configure_mesh()
                 .x_desc("log2(alpha)")
-                .y_desc("ln p(D | M)")
+                .y_desc("nats")
+                .draw()
+                .map_err(plot_err)?;
+            for (label, pts, color) in &terms {
+                let color = *color;
+                chart
+                    .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                    .map_err(plot_err)?
+                    .label(*label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                    .map_err(plot_err)?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(plot_err)?;
+            let width = 0.4 * (x1 - x0) / (classes.len() as f64 + 1.0);
+            let mut chart = ChartBuilder::on(&bottom)
+                .caption(
+                    "(b) Class probabilities p(M | D) (Eq. 32)",
+                    ("sans-serif", 18),
+                )
+                .margin(15)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
+                .build_cartesian_2d(x0..x1, 0.0..1.05)
+                .map_err(plot_err)?;
+            chart
+                .configure_mesh()
+                .x_desc("log2(alpha)")
+                .y_desc("p(M | D)")
                 .draw()
                 .map_err(plot_err)?;
             chart
-                .draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(2)))
-                .map_err(plot_err)?;
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
+                .draw_series(probabilities.iter().map(|&(x, p)| {
+                    Rectangle::new([(x - width, 0.0), (x + width, p)], BLUE.mix(0.6).filled())
+                }))
                 .map_err(plot_err)?;
         }
         root.present().map_err(plot_err)?;

@@ -16,6 +16,9 @@
 //! s over n repetitions enters exactly through sum_j (x_j - m)^2 = n (x_mean - m)^2 + (n - 1) s^2.
 //! theta = [model parameters..., sigma_w^2 (Hz^2)].
 //!
+//! With [`MillingPoleLikelihood::with_surrogate`] the multipliers come from a Gaussian-process
+//! surrogate trained on the exact ones ([`crate::surrogate`], 002 Section 2.2) instead.
+//!
 //! Every condition's discretization grid is fixed at the nominal model
 //! ([`Discretization::resolved`]), so that the operator of every theta has the same dimension and
 //! the likelihood is a smooth function of theta.
@@ -68,6 +71,7 @@ pub struct MillingPoleLikelihood {
     conditions: Vec<Condition>,
     alpha: f64,
     poles: f64,
+    surrogate: Option<std::sync::Arc<crate::surrogate::PoleSurrogate>>,
 }
 
 impl MillingPoleLikelihood {
@@ -121,7 +125,18 @@ impl MillingPoleLikelihood {
             conditions,
             alpha,
             poles: total,
+            surrogate: None,
         })
+    }
+
+    /// The same likelihood with the multipliers predicted by `surrogate` (trained on this
+    /// likelihood's conditions, [`crate::surrogate::PoleSurrogate::train`]).
+    pub fn with_surrogate(
+        mut self,
+        surrogate: std::sync::Arc<crate::surrogate::PoleSurrogate>,
+    ) -> Self {
+        self.surrogate = Some(surrogate);
+        self
     }
 
     /// Number of sampled parameters (model parameters plus sigma_w^2).
@@ -139,19 +154,34 @@ impl MillingPoleLikelihood {
         &self.parameterization
     }
 
-    /// Predicted (frequency Hz, damping ratio) of the dominant multiplier at every condition, for
-    /// the model parameters `theta_m`.
-    pub fn predicted_poles(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64)>> {
+    /// The exact dominant multiplier of the monodromy operator at every condition, for the model
+    /// parameters `theta_m`.
+    pub fn exact_multipliers(&self, theta_m: &[f64]) -> Result<Vec<DominantMultiplier>> {
         let model = self.parameterization.model(theta_m)?;
         self.conditions
             .iter()
             .map(|c| {
                 let m = condition_model(&model, c.radial_immersion)?;
                 let op = c.solver.monodromy(&m, c.speed_rpm, c.depth_m)?;
-                let mu = DominantMultiplier::new(op.dominant_eigenvalue()?, op.period_s);
-                Ok(multiplier_frequency_damping(&mu))
+                Ok(DominantMultiplier::new(
+                    op.dominant_eigenvalue()?,
+                    op.period_s,
+                ))
             })
             .collect()
+    }
+
+    /// Predicted (frequency Hz, damping ratio) of the dominant multiplier at every condition, for
+    /// the model parameters `theta_m`: exact, or from the surrogate when there is one.
+    pub fn predicted_poles(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64)>> {
+        match &self.surrogate {
+            Some(s) => s.poles(theta_m),
+            None => Ok(self
+                .exact_multipliers(theta_m)?
+                .iter()
+                .map(multiplier_frequency_damping)
+                .collect()),
+        }
     }
 
     /// ln p(D | theta, M(alpha)) (Eq. 15); -inf where the model cannot be built or its

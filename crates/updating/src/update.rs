@@ -48,6 +48,9 @@ pub struct UpdateSettings {
     pub priors: PriorOverrides,
     /// Model classes alpha.
     pub classes: Option<Vec<f64>>,
+    /// Milling poles: replace the exact multipliers by a GP surrogate trained on this many
+    /// points of the prior box ([`crate::surrogate`], 002 Section 2.2). Ignored otherwise.
+    pub surrogate_training_points: Option<usize>,
 }
 
 /// A validated updating job.
@@ -58,6 +61,7 @@ pub struct UpdateJob {
     names: Vec<String>,
     alphas: Vec<f64>,
     data: Data,
+    surrogate_training_points: Option<usize>,
 }
 
 /// One model class in the result.
@@ -72,6 +76,13 @@ pub struct ClassSummary {
     /// Likelihood evaluations of the sampler that failed numerically (iTMCMC / TMCMC).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub numerical_failures: Option<usize>,
+    /// E[ln p(D | theta, M)] over the posterior: the data fit of 000 Eq. 33 (iTMCMC / TMCMC).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub data_fit: Option<f64>,
+    /// E[ln p(theta | D, M) / p(theta | M)] = data fit - ln p(D | M): the information gain of
+    /// 000 Eq. 33, in nats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub information_gain: Option<f64>,
 }
 
 /// The result of a job.
@@ -91,7 +102,27 @@ pub struct UpdateResult {
     pub selected_alpha: Option<f64>,
     /// The model at the posterior mean of the model parameters.
     pub updated_model: ModalModel,
+    /// Parameters whose posterior piles against a bound of its prior (the prior decides them).
+    pub prior_bound_pileups: Vec<crate::prior_bounds::BoundPileup>,
+    /// The surrogate's errors, when one replaced the exact likelihood.
+    pub surrogate: Option<SurrogateReport>,
 }
+
+/// How well the GP surrogate stood in for the exact milling likelihood.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SurrogateReport {
+    /// Pole errors at held-out points of the prior box.
+    pub held_out: crate::surrogate::SurrogateCheck,
+    /// Posterior samples of the selected class at which the likelihoods were compared.
+    pub posterior_points: usize,
+    /// Mean |ln L_surrogate - ln L_exact| over those samples.
+    pub mean_abs_ln_likelihood_error: f64,
+    /// Largest |ln L_surrogate - ln L_exact|.
+    pub max_abs_ln_likelihood_error: f64,
+}
+
+/// Posterior samples at which the surrogate's likelihood is compared with the exact one.
+const SURROGATE_POSTERIOR_CHECKS: usize = 50;
 
 impl UpdateJob {
     /// Validate model, observations and settings into a job.
@@ -174,6 +205,7 @@ impl UpdateJob {
             names,
             alphas,
             data,
+            surrogate_training_points: settings.surrogate_training_points,
         })
     }
 
@@ -199,6 +231,7 @@ impl UpdateJob {
         observer: &dyn ClassObserver,
     ) -> Result<UpdateResult> {
         let p = &self.parameterization;
+        let mut surrogate = None;
         let (samples, classes, selected_alpha) = match &self.data {
             Data::Cuts(cuts) => {
                 observer.class_started(0, 1, f64::NAN);
@@ -214,6 +247,8 @@ impl UpdateJob {
                     log_evidence: post.log_evidence,
                     probability: 1.0,
                     numerical_failures: post.numerical_failures,
+                    data_fit: post.data_fit,
+                    information_gain: post.data_fit.map(|f| f - post.log_evidence),
                 };
                 (post.samples, vec![class], None)
             }
@@ -235,21 +270,47 @@ impl UpdateJob {
                 )?)
             }
             Data::MillingPoles(poles) => {
-                let make = |alpha| {
-                    MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())
+                let exact = MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?;
+                let gp = match self.surrogate_training_points {
+                    Some(n) => {
+                        let boxes: Vec<(f64, f64)> = self.prior.marginals()[..p.dimension()]
+                            .iter()
+                            .map(crate::surrogate::prior_box)
+                            .collect();
+                        Some(std::sync::Arc::new(crate::surrogate::PoleSurrogate::train(
+                            &exact, &boxes, n,
+                        )?))
+                    }
+                    None => None,
                 };
-                summarize(select_model_class(
+                let make = |alpha| {
+                    let like =
+                        MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())?;
+                    Ok(match &gp {
+                        Some(g) => like.with_surrogate(g.clone()),
+                        None => like,
+                    })
+                };
+                let (samples, classes, alpha) = summarize(select_model_class(
                     &self.prior,
                     &self.alphas,
                     make,
                     options,
                     observer,
-                )?)
+                )?);
+                if let (Some(g), Some(a)) = (&gp, alpha) {
+                    surrogate = Some(surrogate_report(g, poles, p, a, &samples)?);
+                }
+                (samples, classes, alpha)
             }
         };
         let mean = samples.mean();
         let updated_model = p.model(&mean[..p.dimension()])?;
+        let prior_bound_pileups =
+            crate::prior_bounds::prior_bound_pileups(&self.names, self.prior.marginals(), &samples);
         Ok(UpdateResult {
+            prior_bound_pileups,
+            surrogate,
             parameter_names: self.names.clone(),
             posterior_covariance: samples.covariance(),
             posterior_mean: mean,
@@ -259,6 +320,36 @@ impl UpdateJob {
             updated_model,
         })
     }
+}
+
+/// The surrogate's pole errors at held-out prior points and its likelihood error at posterior
+/// samples of the selected class `alpha`.
+fn surrogate_report(
+    gp: &std::sync::Arc<crate::surrogate::PoleSurrogate>,
+    poles: &[PoleObservation],
+    p: &Parameterization,
+    alpha: f64,
+    samples: &SampleSet,
+) -> Result<SurrogateReport> {
+    use rayon::prelude::*;
+    let exact = MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())?;
+    let approx = exact.clone().with_surrogate(gp.clone());
+    let held_out = gp.check(&exact, crate::surrogate::DEFAULT_CHECK_POINTS)?;
+    let all = samples.samples();
+    let step = (all.len() / SURROGATE_POSTERIOR_CHECKS).max(1);
+    let errors: Vec<f64> = all
+        .par_iter()
+        .step_by(step)
+        .map(|t| (approx.ln_likelihood(t) - exact.ln_likelihood(t)).abs())
+        .filter(|e| e.is_finite())
+        .collect();
+    let n = errors.len();
+    Ok(SurrogateReport {
+        held_out,
+        posterior_points: n,
+        mean_abs_ln_likelihood_error: errors.iter().sum::<f64>() / n.max(1) as f64,
+        max_abs_ln_likelihood_error: errors.iter().copied().fold(0.0, f64::max),
+    })
 }
 
 fn summarize(
@@ -273,6 +364,8 @@ fn summarize(
             log_evidence: c.posterior.log_evidence,
             probability,
             numerical_failures: c.posterior.numerical_failures,
+            data_fit: c.posterior.data_fit,
+            information_gain: c.posterior.data_fit.map(|f| f - c.posterior.log_evidence),
         })
         .collect();
     let selected = selection.selected_class();
