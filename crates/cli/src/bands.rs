@@ -19,11 +19,12 @@ use std::path::Path;
 /// Band kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum BandKind {
-    /// Geometric Type B offsets (seed 001).
+    /// Type B offset boundaries from stated speed and depth offsets (Schmitz 2023).
     Geometric,
-    /// Second-order perturbation credibility bounds (seed 000 Eq. 14-18).
+    /// Credibility bounds from a parameter covariance by second-order perturbation of the
+    /// dominant eigenvalue (Ahmadi 2022).
     Perturbation,
-    /// Monte Carlo probability of stability (seed 004 Fig. 2).
+    /// Probability of stability from sampled parameters (Monte Carlo, Schmitz et al. 2022).
     Montecarlo,
 }
 
@@ -95,22 +96,7 @@ fn geometric(
     let lobes = compute_lobes(model, req.method.unwrap_or(Method::Zoa), speeds, req.quiet)?;
     let curve = finite_curve(&lobes);
     let bands = type_b_offsets(&curve, TypeBOffsets::new(req.offsets.0, req.offsets.1)?)?;
-    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance\n");
-    for p in &bands.points {
-        let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
-        let up = OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{}",
-            p.speed_rpm,
-            p.depth_mm,
-            cell(lo),
-            cell(up),
-            p.theta_deg,
-            p.distance
-        );
-    }
-    emit(req.out, &csv)?;
+    emit(req.out, &geometric_csv(&bands))?;
     if let Some(path) = req.plot {
         let series = band_series(
             curve,
@@ -126,8 +112,79 @@ fn geometric(
             &series,
             markers(obs).as_ref(),
         )?;
+        theta_distance_plots(path, &bands)?;
     }
     Ok(())
+}
+
+/// CSV of Type B offsets (001): per mean-boundary point the lower and upper boundaries at its
+/// speed (`lower_mm`, `upper_mm`, from the gap-filled, loop-free polylines), Eq. 2's angle
+/// `theta_deg` and Eq. 1's distance `distance` (rpm / um units), and the raw roots of Eq. 10-11
+/// (`upper_speed_rpm`, `upper_depth_mm`, `lower_speed_rpm`, `lower_depth_mm`), unmodified.
+pub fn geometric_csv(bands: &OffsetBoundaries) -> String {
+    let mut csv = String::from(
+        "speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance,upper_speed_rpm,\
+         upper_depth_mm,lower_speed_rpm,lower_depth_mm\n",
+    );
+    for p in &bands.points {
+        let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
+        let up = OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{},{}",
+            p.speed_rpm,
+            p.depth_mm,
+            cell(lo),
+            cell(up),
+            p.theta_deg,
+            p.distance,
+            p.upper.0,
+            p.upper.1,
+            p.lower.0,
+            p.lower.1
+        );
+    }
+    csv
+}
+
+/// 001 Figs. 7-10: Eq. 2's angle theta and Eq. 1's offset distance d along the mean boundary,
+/// written beside `plot` as `NAME-theta.svg` and `NAME-distance.svg`; returns their paths.
+pub fn theta_distance_plots(
+    plot: &Path,
+    bands: &OffsetBoundaries,
+) -> Result<[std::path::PathBuf; 2]> {
+    let stem = plot
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "bands".into());
+    let sibling = |suffix: &str| plot.with_file_name(format!("{stem}-{suffix}.svg"));
+    let series = |label: &str, f: fn(&chatter_uncertainty::geometric::PointOffset) -> f64| {
+        [Series {
+            label: label.into(),
+            points: bands.points.iter().map(|p| (p.speed_rpm, f(p))).collect(),
+            color: BLUE,
+            dashed: false,
+        }]
+    };
+    let theta = sibling("theta");
+    line_chart(
+        &theta,
+        "Boundary angle along the mean boundary (001 Eq. 2)",
+        "spindle speed (rpm)",
+        "theta (deg)",
+        &series("theta", |p| p.theta_deg),
+        None,
+    )?;
+    let distance = sibling("distance");
+    line_chart(
+        &distance,
+        "Offset distance along the mean boundary (001 Eq. 1)",
+        "spindle speed (rpm)",
+        "d (rpm / um units)",
+        &series("d", |p| p.distance),
+        None,
+    )?;
+    Ok([theta, distance])
 }
 
 fn cell(v: Option<f64>) -> String {

@@ -256,7 +256,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     let path = out_dir.join("turning_lobes.svg");
     line_chart(
         &path,
-        "Seed 000 turning tool: nominal lobes (FDM) and test cuts",
+        "Turning tool of 000 (Table 1 hammer modes): FDM lobes and test cuts",
         "spindle speed (rpm)",
         "width of cut (mm)",
         &[Series {
@@ -319,10 +319,13 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         .map(|p| (p.speed_rpm, p.depth_mm()))
         .collect();
     let bands = type_b_offsets(&curve, TypeBOffsets::new(100.0, 0.2)?)?;
+    let path = out_dir.join("milling_bands.csv");
+    write_atomic(&path, crate::bands::geometric_csv(&bands).as_bytes())?;
+    written.push(path);
     let path = out_dir.join("milling_bands.svg");
     line_chart(
         &path,
-        "Seed 001 milling example: zero-order lobes with Type B offsets",
+        "Milling example of 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm)",
         "spindle speed (rpm)",
         "axial depth (mm)",
         &crate::bands::band_series(
@@ -333,7 +336,8 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         ),
         None,
     )?;
-    written.push(path);
+    written.push(path.clone());
+    written.extend(crate::bands::theta_distance_plots(&path, &bands)?);
     let path = out_dir.join("milling_frf.csv");
     write_atomic(&path, frf_csv(&milling, 0.0, 1500.0, 301, 0, 0).as_bytes())?;
     written.push(path);

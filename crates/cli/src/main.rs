@@ -114,8 +114,8 @@ enum Command {
         /// Model file.
         #[arg(long)]
         model: PathBuf,
-        /// Band kind: geometric (Type B offsets, seed 001), perturbation (second-order
-        /// credibility bounds, seed 000) or montecarlo (probability of stability, seed 004).
+        /// Band kind: geometric (Type B offsets in speed and depth), perturbation (credibility
+        /// bounds from a parameter covariance) or montecarlo (probability of stability).
         #[arg(long, value_enum, default_value = "geometric")]
         kind: BandKind,
         /// Stability method; default zoa for geometric, fdm otherwise.

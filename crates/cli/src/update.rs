@@ -202,6 +202,26 @@ fn write_outputs(
         csv += &format!("{},{w:e}\n", row.join(","));
     }
     write_atomic(&out.join("posterior.csv"), csv.as_bytes())?;
+    if !r.pole_table.is_empty() {
+        let mut t = String::from(
+            "speed_rpm,depth_mm,identified_hz,identified_damping,nominal_hz,nominal_damping,\
+             updated_hz,updated_damping\n",
+        );
+        for p in &r.pole_table {
+            t += &format!(
+                "{},{},{},{},{},{},{},{}\n",
+                p.speed_rpm,
+                p.depth_mm,
+                p.identified_hz,
+                p.identified_damping,
+                p.nominal_hz,
+                p.nominal_damping,
+                p.updated_hz,
+                p.updated_damping
+            );
+        }
+        write_atomic(&out.join("poles.csv"), t.as_bytes())?;
+    }
     let n = r.posterior_covariance.nrows();
     let covariance: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| r.posterior_covariance[(i, j)]).collect())

@@ -12,7 +12,20 @@
 //! J_p(theta) = sum_j (w_hat_pj - w_p(theta))^2 / sigma_w^2 + (zeta_hat_pj - zeta_p(theta))^2 / (alpha sigma_w)^2,
 //! ln p(D | theta, M(alpha)) = -1/2 sum_p J_p - N ln(2 pi alpha sigma_w^2),
 //!
-//! N the number of identified poles. Frequencies are in Hz. A table of mean and standard deviation
+//! N the number of identified poles. Frequencies are in Hz.
+//!
+//! Units of alpha: with sigma_w in Hz, alpha = sigma_zeta / sigma_w is per Hz. 002 writes the
+//! frequency as omega and does not state its unit; if its sigma_omega is in rad/s, its alpha is
+//! 2 pi times smaller than the alpha here for the same weighting (alpha_Hz = 2 pi alpha_rad/s),
+//! so its selected classes 0.01 (Section 3.1) and 0.006 (Section 3.2) correspond to 0.063 and
+//! 0.038 here. The class grid of [`crate::defaults::milling_alphas`] (0.001 to 1) spans both
+//! readings.
+//!
+//! 002's simulated poles (Table 1) are not those of its stated simulation model (194 Hz): its
+//! lifted frequencies sit a constant 1.2 Hz from the monodromy poles of that model
+//! (2000 rpm / 0.5 mm: 4.6 Hz in the table, 5.85 Hz at 194 Hz), and the experimental hammer
+//! frequency 195.3 Hz removes the offset (4.63 Hz; 2100 rpm / 0.4 mm: 14.05 against 14.06 Hz),
+//! so the table was most likely simulated with 195.3 Hz. A table of mean and standard deviation
 //! s over n repetitions enters exactly through sum_j (x_j - m)^2 = n (x_mean - m)^2 + (n - 1) s^2.
 //! theta = [model parameters..., sigma_w^2 (Hz^2)].
 //!

@@ -62,6 +62,7 @@ pub struct UpdateJob {
     alphas: Vec<f64>,
     data: Data,
     surrogate_training_points: Option<usize>,
+    poles: Vec<PoleObservation>,
 }
 
 /// One model class in the result.
@@ -106,12 +107,36 @@ pub struct UpdateResult {
     pub prior_bound_pileups: Vec<crate::prior_bounds::BoundPileup>,
     /// The surrogate's errors, when one replaced the exact likelihood.
     pub surrogate: Option<SurrogateReport>,
+    /// Identified poles against those of the nominal and the updated model (empty for cuts).
+    pub pole_table: Vec<PoleComparison>,
+}
+
+/// An identified pole beside the model's prediction before and after updating.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PoleComparison {
+    /// Spindle speed (rpm).
+    pub speed_rpm: f64,
+    /// Depth or width of cut (mm).
+    pub depth_mm: f64,
+    /// Identified frequency (Hz; lifted principal frequency for milling).
+    pub identified_hz: f64,
+    /// Identified damping ratio.
+    pub identified_damping: f64,
+    /// Nominal model's frequency (Hz).
+    pub nominal_hz: f64,
+    /// Nominal model's damping ratio.
+    pub nominal_damping: f64,
+    /// Updated model's (posterior mean) frequency (Hz).
+    pub updated_hz: f64,
+    /// Updated model's damping ratio.
+    pub updated_damping: f64,
 }
 
 /// How well the GP surrogate stood in for the exact milling likelihood.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct SurrogateReport {
-    /// Pole errors at held-out points of the prior box.
+    /// Pole errors of the global surrogate (before refinement) at held-out points of the prior
+    /// box.
     pub held_out: crate::surrogate::SurrogateCheck,
     /// Posterior samples of the selected class at which the likelihoods were compared.
     pub posterior_points: usize,
@@ -206,6 +231,7 @@ impl UpdateJob {
             alphas,
             data,
             surrogate_training_points: settings.surrogate_training_points,
+            poles: poles.clone(),
         })
     }
 
@@ -271,7 +297,7 @@ impl UpdateJob {
             }
             Data::MillingPoles(poles) => {
                 let exact = MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?;
-                let gp = match self.surrogate_training_points {
+                let global = match self.surrogate_training_points {
                     Some(n) => {
                         let boxes: Vec<(f64, f64)> = self.prior.marginals()[..p.dimension()]
                             .iter()
@@ -283,11 +309,23 @@ impl UpdateJob {
                     }
                     None => None,
                 };
-                let make = |alpha| {
+                let refined = std::sync::Mutex::new(Vec::new());
+                let make = |alpha: f64| {
                     let like =
                         MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())?;
-                    Ok(match &gp {
-                        Some(g) => like.with_surrogate(g.clone()),
+                    Ok(match &global {
+                        Some(g) => {
+                            let s = crate::surrogate::refined_for_class(
+                                &like,
+                                g.clone(),
+                                &self.prior,
+                                options.seed,
+                            )?;
+                            if let Ok(mut r) = refined.lock() {
+                                r.push((alpha, s.clone()));
+                            }
+                            like.with_surrogate(s)
+                        }
                         None => like,
                     })
                 };
@@ -298,17 +336,23 @@ impl UpdateJob {
                     options,
                     observer,
                 )?);
-                if let (Some(g), Some(a)) = (&gp, alpha) {
-                    surrogate = Some(surrogate_report(g, poles, p, a, &samples)?);
+                let chosen = refined
+                    .into_inner()
+                    .ok()
+                    .and_then(|r| r.into_iter().find(|(a, _)| Some(*a) == alpha));
+                if let (Some((a, g)), Some(global)) = (chosen, &global) {
+                    surrogate = Some(surrogate_report(&g, global, poles, p, a, &samples)?);
                 }
                 (samples, classes, alpha)
             }
         };
         let mean = samples.mean();
         let updated_model = p.model(&mean[..p.dimension()])?;
+        let pole_table = self.pole_table(&mean[..p.dimension()])?;
         let prior_bound_pileups =
             crate::prior_bounds::prior_bound_pileups(&self.names, self.prior.marginals(), &samples);
         Ok(UpdateResult {
+            pole_table,
             prior_bound_pileups,
             surrogate,
             parameter_names: self.names.clone(),
@@ -322,10 +366,75 @@ impl UpdateJob {
     }
 }
 
+impl UpdateJob {
+    /// (frequency Hz, damping) of the model's pole at every identified condition for `theta_m`
+    /// (exact: the characteristic root nearest the identified pole in turning, the dominant
+    /// multiplier of the monodromy in milling), in the order of `self.poles`.
+    fn predicted(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64)>> {
+        let p = &self.parameterization;
+        match &self.data {
+            Data::Cuts(_) => Ok(Vec::new()),
+            Data::MillingPoles(poles) => {
+                MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?
+                    .predicted_poles(theta_m)
+            }
+            Data::TurningPoles(expanded) => {
+                let like = TurningPoleLikelihood::new(
+                    p.clone(),
+                    expanded.clone(),
+                    1.0,
+                    ResidualForm::PoleError,
+                )?;
+                let roots = like.predicted_poles(theta_m)?;
+                self.poles
+                    .iter()
+                    .map(|o| {
+                        roots
+                            .iter()
+                            .find(|r| r.0 == o.speed_rpm && (r.1 - o.depth_mm * 1e-3).abs() < 1e-12)
+                            .map(|r| chatter_dynamics::pole::pole_frequency_damping(r.2))
+                            .ok_or_else(|| {
+                                UpdatingError::Observations(format!(
+                                    "no prediction at {} rpm, {} mm",
+                                    o.speed_rpm, o.depth_mm
+                                ))
+                            })
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Identified against predicted poles, nominal and at `theta_m`.
+    fn pole_table(&self, theta_m: &[f64]) -> Result<Vec<PoleComparison>> {
+        if matches!(self.data, Data::Cuts(_)) {
+            return Ok(Vec::new());
+        }
+        let nominal = self.predicted(&self.parameterization.nominal_theta())?;
+        let updated = self.predicted(theta_m)?;
+        Ok(self
+            .poles
+            .iter()
+            .zip(nominal.iter().zip(&updated))
+            .map(|(o, (n, u))| PoleComparison {
+                speed_rpm: o.speed_rpm,
+                depth_mm: o.depth_mm,
+                identified_hz: o.frequency_hz,
+                identified_damping: o.damping_ratio,
+                nominal_hz: n.0,
+                nominal_damping: n.1,
+                updated_hz: u.0,
+                updated_damping: u.1,
+            })
+            .collect())
+    }
+}
+
 /// The surrogate's pole errors at held-out prior points and its likelihood error at posterior
 /// samples of the selected class `alpha`.
 fn surrogate_report(
     gp: &std::sync::Arc<crate::surrogate::PoleSurrogate>,
+    global: &crate::surrogate::PoleSurrogate,
     poles: &[PoleObservation],
     p: &Parameterization,
     alpha: f64,
@@ -334,7 +443,7 @@ fn surrogate_report(
     use rayon::prelude::*;
     let exact = MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())?;
     let approx = exact.clone().with_surrogate(gp.clone());
-    let held_out = gp.check(&exact, crate::surrogate::DEFAULT_CHECK_POINTS)?;
+    let held_out = global.check(&exact, crate::surrogate::DEFAULT_CHECK_POINTS)?;
     let all = samples.samples();
     let step = (all.len() / SURROGATE_POSTERIOR_CHECKS).max(1);
     let errors: Vec<f64> = all
