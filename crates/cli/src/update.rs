@@ -187,13 +187,18 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             p.posterior_median
         );
     }
-    write_outputs(&args.out, &result, &model)
+    let prior = job.prior_draws(PRIOR_DRAWS, args.seed);
+    write_outputs(&args.out, &result, &model, &prior)
 }
+
+/// Prior draws shown in the corner plot.
+const PRIOR_DRAWS: usize = 2000;
 
 fn write_outputs(
     out: &Path,
     r: &UpdateResult,
     nominal: &chatter_dynamics::ModalModel,
+    prior: &[Vec<f64>],
 ) -> Result<()> {
     // posterior.csv: one row per sample, the parameters then the sample weight
     let mut csv = r.parameter_names.join(",") + ",weight\n";
@@ -249,7 +254,7 @@ fn write_outputs(
         (updated.to_json_string() + "\n").as_bytes(),
     )?;
     evidence_plot(&out.join("evidence.svg"), r)?;
-    corner_plot(&out.join("corner.svg"), r)
+    corner_plot(&out.join("corner.svg"), r, prior)
 }
 
 fn plot_err(e: impl std::fmt::Display) -> anyhow::Error {
@@ -366,17 +371,27 @@ fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
     write_atomic(path, svg.as_bytes())
 }
 
-/// Histograms on the diagonal, pairwise scatter below it (000 Fig. 5).
-fn corner_plot(path: &Path, r: &UpdateResult) -> Result<()> {
+/// 000 Fig. 5: on the diagonal the posterior histogram of each parameter with the Gaussian of
+/// the posterior mean and standard deviation (the fit of 000 Section 6.4), on the posterior's
+/// range; below it pairwise scatter of prior draws (grey) and posterior samples (blue) on the
+/// range of both.
+fn corner_plot(path: &Path, r: &UpdateResult, prior: &[Vec<f64>]) -> Result<()> {
     let d = r.parameter_names.len();
     let samples = r.samples.samples();
+    let span = |rows: &mut dyn Iterator<Item = f64>| {
+        rows.fold((f64::INFINITY, f64::NEG_INFINITY), |a, x| {
+            (a.0.min(x), a.1.max(x))
+        })
+    };
     let ranges: Vec<(f64, f64)> = (0..d)
         .map(|k| {
-            let (lo, hi) = samples
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |a, s| {
-                    (a.0.min(s[k]), a.1.max(s[k]))
-                });
+            let (lo, hi) = span(&mut samples.iter().map(|s| s[k]));
+            padded(lo, hi)
+        })
+        .collect();
+    let joint: Vec<(f64, f64)> = (0..d)
+        .map(|k| {
+            let (lo, hi) = span(&mut samples.iter().chain(prior).map(|s| s[k]).filter(|x| x.is_finite()));
             padded(lo, hi)
         })
         .collect();
@@ -401,7 +416,18 @@ fn corner_plot(path: &Path, r: &UpdateResult) -> Result<()> {
                     let b = (((s[j] - x0) / width) as usize).min(bins - 1);
                     counts[b] += w;
                 }
-                let top = counts.iter().copied().fold(0.0, f64::max).max(1e-300);
+                let (m, sd) = (r.posterior_mean[j], r.posterior_covariance[(j, j)].sqrt());
+                let total: f64 = counts.iter().sum();
+                let peak = if sd > 0.0 {
+                    total * width / (sd * (2.0 * std::f64::consts::PI).sqrt())
+                } else {
+                    0.0
+                };
+                let top = counts
+                    .iter()
+                    .copied()
+                    .fold(peak, f64::max)
+                    .max(1e-300);
                 let mut chart = ChartBuilder::on(area)
                     .caption(&r.parameter_names[j], ("sans-serif", 12))
                     .margin(6)
@@ -421,8 +447,20 @@ fn corner_plot(path: &Path, r: &UpdateResult) -> Result<()> {
                         Rectangle::new([(left, 0.0), (left + width, c)], BLUE.mix(0.6).filled())
                     }))
                     .map_err(plot_err)?;
+                // the fitted Gaussian, scaled to the histogram's mass per bin
+                if sd > 0.0 {
+                    let curve = (0..=200).map(|q| {
+                        let x = x0 + (x1 - x0) * f64::from(q) / 200.0;
+                        let z = (x - m) / sd;
+                        let pdf = (-0.5 * z * z).exp() / (sd * (2.0 * std::f64::consts::PI).sqrt());
+                        (x, total * width * pdf)
+                    });
+                    chart
+                        .draw_series(LineSeries::new(curve, RED.stroke_width(2)))
+                        .map_err(plot_err)?;
+                }
             } else {
-                let (y0, y1) = ranges[i];
+                let ((x0, x1), (y0, y1)) = (joint[j], joint[i]);
                 let mut chart = ChartBuilder::on(area)
                     .margin(6)
                     .x_label_area_size(20)
@@ -434,6 +472,14 @@ fn corner_plot(path: &Path, r: &UpdateResult) -> Result<()> {
                     .x_labels(3)
                     .y_labels(3)
                     .draw()
+                    .map_err(plot_err)?;
+                chart
+                    .draw_series(
+                        prior
+                            .iter()
+                            .filter(|s| s[j].is_finite() && s[i].is_finite())
+                            .map(|s| Circle::new((s[j], s[i]), 1, RGBColor(170, 170, 170).filled())),
+                    )
                     .map_err(plot_err)?;
                 let step = (samples.len() / 2000).max(1);
                 chart

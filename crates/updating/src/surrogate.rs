@@ -277,8 +277,11 @@ impl PoleSurrogate {
     }
 }
 
-/// Pilot posterior samples of each refinement stage of [`refined_for_class`].
+/// Pilot posterior samples of each refinement stage of [`refined_for_class`] (fewer when the
+/// update itself draws fewer, but at least [`MIN_PILOT_SAMPLES`]).
 pub const PILOT_SAMPLES: usize = 300;
+/// Fewest pilot samples of a refinement stage.
+pub const MIN_PILOT_SAMPLES: usize = 50;
 /// Refinement stages of [`refined_for_class`].
 pub const REFINEMENTS: usize = 2;
 /// Training points of each local surrogate of [`refined_for_class`].
@@ -290,18 +293,20 @@ pub const LOCAL_TRAINING_POINTS: usize = 100;
 /// samples are drawn (TMCMC) with the current surrogate, and a new surrogate of
 /// [`LOCAL_TRAINING_POINTS`] exact evaluations is trained on the box they span widened by its
 /// own width on each side (within the prior box), answering inside that box and deferring to
-/// the previous one outside. `likelihood` fixes the class (alpha) and the conditions.
+/// the previous one outside. `likelihood` fixes the class (alpha) and the conditions; `samples`
+/// is the size of the final posterior sample (it caps the pilots).
 pub fn refined_for_class(
     likelihood: &MillingPoleLikelihood,
     global: Arc<PoleSurrogate>,
     prior: &chatter_bayes::prior::IndependentPrior,
+    samples: usize,
     seed: u64,
 ) -> Result<Arc<PoleSurrogate>> {
     let d = likelihood.parameterization().dimension();
     let prior_boxes: Vec<(f64, f64)> = prior.marginals()[..d].iter().map(prior_box).collect();
     let options = crate::classes::SamplerOptions {
         sampler: crate::classes::Sampler::Tmcmc,
-        samples: PILOT_SAMPLES,
+        samples: PILOT_SAMPLES.min(samples.max(MIN_PILOT_SAMPLES)),
         seed,
     };
     let mut current = global;

@@ -250,6 +250,22 @@ impl UpdateJob {
         &self.prior
     }
 
+    /// `n` independent draws from the joint prior (seeded), e.g. to plot beside the posterior
+    /// (000 Fig. 5).
+    pub fn prior_draws(&self, n: usize, seed: u64) -> Vec<Vec<f64>> {
+        use rand::SeedableRng;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                self.prior
+                    .marginals()
+                    .iter()
+                    .map(|m| m.sample(&mut rng))
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Sample every class and summarize the selected one.
     pub fn run(
         &self,
@@ -319,6 +335,7 @@ impl UpdateJob {
                                 &like,
                                 g.clone(),
                                 &self.prior,
+                                options.samples,
                                 options.seed,
                             )?;
                             if let Ok(mut r) = refined.lock() {
