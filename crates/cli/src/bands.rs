@@ -267,7 +267,10 @@ fn perturbation(
     if let Some(path) = req.plot {
         line_chart(
             path,
-            &format!("Credibility bounds at the posterior mean: {}", rule_title(rule)),
+            &format!(
+                "Credibility bounds at the posterior mean: {}",
+                rule_title(rule)
+            ),
             "spindle speed (rpm)",
             "depth (mm)",
             &series,

@@ -416,7 +416,10 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
 /// theta_omega_2, theta_zeta_2, theta_phi_2, written to `eq34_covariance.json` in `out_dir`.
 fn eq34_distribution(
     out_dir: &Path,
-) -> Result<(std::path::PathBuf, chatter_uncertainty::parameters::ParameterDistribution)> {
+) -> Result<(
+    std::path::PathBuf,
+    chatter_uncertainty::parameters::ParameterDistribution,
+)> {
     let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
     let mean = vec![0.0067, 0.1385, 0.0549];
     let eq34 = vec![

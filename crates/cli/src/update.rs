@@ -283,8 +283,16 @@ fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
             .collect::<Vec<_>>()
     };
     let terms = [
-        ("ln p(D | M) (evidence)", curve(&|c| Some(c.log_evidence)), BLUE),
-        ("E[ln p(D | theta, M)] (data fit)", curve(&|c| c.data_fit), GREEN),
+        (
+            "ln p(D | M) (evidence)",
+            curve(&|c| Some(c.log_evidence)),
+            BLUE,
+        ),
+        (
+            "E[ln p(D | theta, M)] (data fit)",
+            curve(&|c| c.data_fit),
+            GREEN,
+        ),
         (
             "E[ln posterior / prior] (information gain)",
             curve(&|c| c.information_gain),
@@ -303,7 +311,10 @@ fn evidence_plot(path: &Path, r: &UpdateResult) -> Result<()> {
             let (top, bottom) = root.split_vertically(480);
             let (x0, x1) = padded(
                 classes.iter().map(|c| c.0).fold(f64::INFINITY, f64::min),
-                classes.iter().map(|c| c.0).fold(f64::NEG_INFINITY, f64::max),
+                classes
+                    .iter()
+                    .map(|c| c.0)
+                    .fold(f64::NEG_INFINITY, f64::max),
             );
             let ys = terms.iter().flat_map(|t| t.1.iter().map(|p| p.1));
             let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
@@ -391,7 +402,13 @@ fn corner_plot(path: &Path, r: &UpdateResult, prior: &[Vec<f64>]) -> Result<()> 
         .collect();
     let joint: Vec<(f64, f64)> = (0..d)
         .map(|k| {
-            let (lo, hi) = span(&mut samples.iter().chain(prior).map(|s| s[k]).filter(|x| x.is_finite()));
+            let (lo, hi) = span(
+                &mut samples
+                    .iter()
+                    .chain(prior)
+                    .map(|s| s[k])
+                    .filter(|x| x.is_finite()),
+            );
             padded(lo, hi)
         })
         .collect();
@@ -423,11 +440,7 @@ fn corner_plot(path: &Path, r: &UpdateResult, prior: &[Vec<f64>]) -> Result<()> 
                 } else {
                     0.0
                 };
-                let top = counts
-                    .iter()
-                    .copied()
-                    .fold(peak, f64::max)
-                    .max(1e-300);
+                let top = counts.iter().copied().fold(peak, f64::max).max(1e-300);
                 let mut chart = ChartBuilder::on(area)
                     .caption(&r.parameter_names[j], ("sans-serif", 12))
                     .margin(6)
@@ -478,7 +491,9 @@ fn corner_plot(path: &Path, r: &UpdateResult, prior: &[Vec<f64>]) -> Result<()> 
                         prior
                             .iter()
                             .filter(|s| s[j].is_finite() && s[i].is_finite())
-                            .map(|s| Circle::new((s[j], s[i]), 1, RGBColor(170, 170, 170).filled())),
+                            .map(|s| {
+                                Circle::new((s[j], s[i]), 1, RGBColor(170, 170, 170).filled())
+                            }),
                     )
                     .map_err(plot_err)?;
                 let step = (samples.len() / 2000).max(1);

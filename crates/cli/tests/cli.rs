@@ -1087,9 +1087,12 @@ fn sensitivity_reproduces_table3_at_p1() {
     }
     let period = run("period");
     let mu = period["eigenvalue"]["modulus"].as_f64().unwrap();
-    let ratio = period["sensitivities"][0]["modulus"].as_f64().unwrap()
-        / s[0]["modulus"].as_f64().unwrap();
-    assert!((ratio - 200.0 * mu.powf(199.0 / 200.0)).abs() < 1e-6 * ratio, "{ratio}");
+    let ratio =
+        period["sensitivities"][0]["modulus"].as_f64().unwrap() / s[0]["modulus"].as_f64().unwrap();
+    assert!(
+        (ratio - 200.0 * mu.powf(199.0 / 200.0)).abs() < 1e-6 * ratio,
+        "{ratio}"
+    );
     let err = fail(
         chatter()
             .args(["sensitivity", "--model"])

@@ -354,7 +354,11 @@ mod tests {
             .collect();
         let mean = r.iter().sum::<f64>() / n as f64;
         let sd = (r.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
-        assert!((mean - m.mean.re).abs() < 0.03 * sd, "{mean} vs {}", m.mean.re);
+        assert!(
+            (mean - m.mean.re).abs() < 0.03 * sd,
+            "{mean} vs {}",
+            m.mean.re
+        );
         assert!((sd - m.std()).abs() < 0.03 * sd, "{sd} vs {}", m.std());
         assert!(m.std() < moments(&s, &sigma).unwrap().std());
     }

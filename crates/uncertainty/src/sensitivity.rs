@@ -175,7 +175,12 @@ mod tests {
             .unwrap();
             for (e, p) in one.entries.iter().zip(paper) {
                 let rel = (e.modulus() - p).abs() / p;
-                assert!(rel < 0.03, "{rpm} rpm {mm} mm {}: {} vs {p}", e.parameter, e.modulus());
+                assert!(
+                    rel < 0.03,
+                    "{rpm} rpm {mm} mm {}: {} vs {p}",
+                    e.parameter,
+                    e.modulus()
+                );
             }
             let back = one.eigenvalue.powu(200);
             assert!(

@@ -54,7 +54,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let boxes: Vec<(f64, f64)> = job.prior().marginals()[..d].iter().map(prior_box).collect();
         let t0 = Instant::now();
         let gp = PoleSurrogate::train(&like, &boxes, points)?;
-        println!("training on {points} points: {:.1} s", t0.elapsed().as_secs_f64());
+        println!(
+            "training on {points} points: {:.1} s",
+            t0.elapsed().as_secs_f64()
+        );
         let t0 = Instant::now();
         for _ in 0..1000 {
             gp.poles(&theta0)?;
@@ -77,7 +80,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let r = job.run(&options, &Silent)?;
         println!(
             "{}: {:.1} s, mean {:.4?}, sd {:.4?}",
-            if surrogate.is_some() { "surrogate" } else { "exact" },
+            if surrogate.is_some() {
+                "surrogate"
+            } else {
+                "exact"
+            },
             t0.elapsed().as_secs_f64(),
             r.posterior_mean,
             (0..r.posterior_mean.len())

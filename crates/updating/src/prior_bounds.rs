@@ -102,8 +102,14 @@ mod tests {
     fn flags_mass_at_a_bound_only() {
         let names = vec!["a".to_string(), "b".to_string(), "c".to_string()];
         let marginals = [
-            Marginal::Uniform { low: 0.0, high: 1.0 },
-            Marginal::Uniform { low: 0.0, high: 1.0 },
+            Marginal::Uniform {
+                low: 0.0,
+                high: 1.0,
+            },
+            Marginal::Uniform {
+                low: 0.0,
+                high: 1.0,
+            },
             Marginal::Normal { mean: 0.0, sd: 1.0 },
         ];
         let n = 1000;

@@ -264,7 +264,9 @@ impl PoleSurrogate {
             .flatten()
             .collect();
         let k = errors.len().max(1) as f64;
-        let rms = |f: fn(&(f64, f64)) -> f64| (errors.iter().map(|e| f(e).powi(2)).sum::<f64>() / k).sqrt();
+        let rms = |f: fn(&(f64, f64)) -> f64| {
+            (errors.iter().map(|e| f(e).powi(2)).sum::<f64>() / k).sqrt()
+        };
         let max = |f: fn(&(f64, f64)) -> f64| errors.iter().map(f).fold(0.0, f64::max);
         Ok(SurrogateCheck {
             training_points: self.training_points,
@@ -342,7 +344,12 @@ mod tests {
     fn halton_points_fill_the_box() {
         let pts = halton_points(&[(-1.0, 1.0), (0.0, 10.0)], 0, 4).unwrap();
         // radical inverses of 1..4 in base 2: 1/2, 1/4, 3/4, 1/8; base 3: 1/3, 2/3, 1/9, 4/9
-        let expect = [(0.5, 1.0 / 3.0), (0.25, 2.0 / 3.0), (0.75, 1.0 / 9.0), (0.125, 4.0 / 9.0)];
+        let expect = [
+            (0.5, 1.0 / 3.0),
+            (0.25, 2.0 / 3.0),
+            (0.75, 1.0 / 9.0),
+            (0.125, 4.0 / 9.0),
+        ];
         for (p, (a, b)) in pts.iter().zip(expect) {
             assert!((p[0] - (-1.0 + 2.0 * a)).abs() < 1e-15);
             assert!((p[1] - 10.0 * b).abs() < 1e-14);

@@ -312,7 +312,8 @@ impl UpdateJob {
                 )?)
             }
             Data::MillingPoles(poles) => {
-                let exact = MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?;
+                let exact =
+                    MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?;
                 let global = match self.surrogate_training_points {
                     Some(n) => {
                         let boxes: Vec<(f64, f64)> = self.prior.marginals()[..p.dimension()]
@@ -327,8 +328,12 @@ impl UpdateJob {
                 };
                 let refined = std::sync::Mutex::new(Vec::new());
                 let make = |alpha: f64| {
-                    let like =
-                        MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())?;
+                    let like = MillingPoleLikelihood::new(
+                        p.clone(),
+                        poles,
+                        alpha,
+                        Discretization::full(),
+                    )?;
                     Ok(match &global {
                         Some(g) => {
                             let s = crate::surrogate::refined_for_class(
