@@ -3,7 +3,7 @@
 
 use crate::commands::{Method, compute_lobes, markers};
 use crate::output::{self, emit, write_atomic};
-use crate::plot::{Series, line_chart};
+use crate::plot::{Series, line_chart, line_chart_svg};
 use crate::validate;
 use crate::{inputs, progress::Bar};
 use anyhow::{Result, bail};
@@ -12,7 +12,7 @@ use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
 use chatter_uncertainty::montecarlo::{FailureKind, sample_boundaries};
 use chatter_uncertainty::parameters::ParameterDistribution;
-use chatter_uncertainty::perturbation::model_moment_grid;
+use chatter_uncertainty::perturbation::{BoundRule, model_moment_grid};
 use plotters::style::{BLUE, GREEN, RGBColor};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -20,11 +20,12 @@ use std::path::Path;
 /// Band kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum BandKind {
-    /// Geometric Type B offsets (seed 001).
+    /// Type B offset boundaries from stated speed and depth offsets (Schmitz 2023).
     Geometric,
-    /// Second-order perturbation credibility bounds (seed 000 Eq. 14-18).
+    /// Credibility bounds from a parameter covariance by second-order perturbation of the
+    /// dominant eigenvalue (Ahmadi 2022).
     Perturbation,
-    /// Monte Carlo probability of stability (seed 004 Fig. 2).
+    /// Probability of stability from sampled parameters (Monte Carlo, Schmitz et al. 2022).
     Montecarlo,
 }
 
@@ -50,6 +51,8 @@ pub struct BandRequest<'a> {
     pub samples: Option<usize>,
     /// Seed of the Monte Carlo draws when given (default 0).
     pub seed: Option<u64>,
+    /// Perturbation bounds of this central credibility of |mu| (None: |E mu| +- sd).
+    pub coverage: Option<f64>,
     /// Observed cuts.
     pub observations: Option<&'a Path>,
     /// CSV destination (stdout when absent).
@@ -194,22 +197,7 @@ fn geometric(
         req.offsets.1.unwrap_or(OFFSET_MM),
     )?;
     let bands = type_b_offsets(&curve, offsets)?;
-    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance\n");
-    for p in &bands.points {
-        let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
-        let up = OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{}",
-            p.speed_rpm,
-            p.depth_mm,
-            cell(lo),
-            cell(up),
-            p.theta_deg,
-            p.distance
-        );
-    }
-    emit(req.out, &csv)?;
+    emit(req.out, &geometric_csv(&bands))?;
     if let Some(path) = req.plot {
         let series = band_series(
             curve,
@@ -225,8 +213,84 @@ fn geometric(
             &series,
             markers(obs).as_ref(),
         )?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "bands".into());
+        for (suffix, svg) in theta_distance_svgs(&bands)? {
+            write_atomic(
+                &path.with_file_name(format!("{stem}-{suffix}.svg")),
+                svg.as_bytes(),
+            )?;
+        }
     }
     Ok(())
+}
+
+/// CSV of Type B offsets (001): per mean-boundary point the lower and upper boundaries at its
+/// speed (`lower_mm`, `upper_mm`, from the gap-filled, loop-free polylines), Eq. 2's angle
+/// `theta_deg` and Eq. 1's distance `distance` (rpm / um units), and the raw roots of Eq. 10-11
+/// (`upper_speed_rpm`, `upper_depth_mm`, `lower_speed_rpm`, `lower_depth_mm`), unmodified.
+pub fn geometric_csv(bands: &OffsetBoundaries) -> String {
+    let mut csv = String::from(
+        "speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance,upper_speed_rpm,\
+         upper_depth_mm,lower_speed_rpm,lower_depth_mm\n",
+    );
+    for p in &bands.points {
+        let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
+        let up = OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{},{}",
+            p.speed_rpm,
+            p.depth_mm,
+            cell(lo),
+            cell(up),
+            p.theta_deg,
+            p.distance,
+            p.upper.0,
+            p.upper.1,
+            p.lower.0,
+            p.lower.1
+        );
+    }
+    csv
+}
+
+/// 001 Figs. 7-10: Eq. 2's angle theta and Eq. 1's offset distance d along the mean boundary,
+/// as SVG texts with the suffix of their file names (`theta`, `distance`): `bands --plot F.svg`
+/// writes them beside the plot as `F-theta.svg` and `F-distance.svg`.
+pub fn theta_distance_svgs(bands: &OffsetBoundaries) -> Result<[(&'static str, String); 2]> {
+    let series = |label: &str, f: fn(&chatter_uncertainty::geometric::PointOffset) -> f64| {
+        [Series {
+            label: label.into(),
+            points: bands.points.iter().map(|p| (p.speed_rpm, f(p))).collect(),
+            color: BLUE,
+            dashed: false,
+        }]
+    };
+    Ok([
+        (
+            "theta",
+            line_chart_svg(
+                "Boundary angle along the mean boundary (001 Eq. 2)",
+                "spindle speed (rpm)",
+                "theta (deg)",
+                &series("theta", |p| p.theta_deg),
+                None,
+            )?,
+        ),
+        (
+            "distance",
+            line_chart_svg(
+                "Offset distance along the mean boundary (001 Eq. 1)",
+                "spindle speed (rpm)",
+                "d (rpm / um units)",
+                &series("d", |p| p.distance),
+                None,
+            )?,
+        ),
+    ])
 }
 
 fn cell(v: Option<f64>) -> String {
@@ -298,17 +362,24 @@ fn perturbation(
     speeds: &[f64],
     obs: Option<&Observations>,
 ) -> Result<()> {
+    let rule = match req.coverage {
+        Some(c) => BoundRule::coverage(c).map_err(|e| anyhow::anyhow!("--coverage: {e}"))?,
+        None => BoundRule::ComplexSd,
+    };
     let dist = distribution(req, model)?;
     let method = discretization(req)?;
     let mean_model = dist.mean_model(model)?;
     let mean_lobes = compute_lobes(&mean_model, req.method.unwrap_or(Method::Fdm), speeds, true)?;
     let depths = depth_grid(req, &mean_lobes)?;
-    let (csv, series) = credibility_bands(&mean_model, &dist, method, speeds, &depths)?;
+    let (csv, series) = credibility_bands(&mean_model, &dist, method, rule, speeds, &depths)?;
     emit(req.out, &csv)?;
     if let Some(path) = req.plot {
         line_chart(
             path,
-            "Second-order perturbation credibility bounds",
+            &format!(
+                "Credibility bounds at the posterior mean: {}",
+                rule_title(rule)
+            ),
             "spindle speed (rpm)",
             "depth (mm)",
             &series,
@@ -318,13 +389,23 @@ fn perturbation(
     Ok(())
 }
 
+/// Plot title of a bound rule.
+pub fn rule_title(rule: BoundRule) -> String {
+    match rule {
+        BoundRule::ComplexSd => "|E mu| +- 1 sd of complex mu (000 Sec. 6.4)".into(),
+        BoundRule::Coverage(c) => format!("{:.0} % credibility of |mu|", 100.0 * c),
+    }
+}
+
 /// Credibility bounds of the model at the distribution's mean (000 Eq. 14-18 with the covariance
-/// about the mean) on a speed x depth grid: CSV `speed_rpm,depth_mm,lower_mm,upper_mm` and the
-/// plot series.
+/// about the mean) on a speed x depth grid under `rule`: CSV
+/// `speed_rpm,depth_mm,lower_mm,upper_mm` (empty cells where a contour is not reached on the
+/// grid) and the plot series, broken (NaN) at those speeds so no line is drawn across a gap.
 pub fn credibility_bands(
     mean_model: &ModalModel,
     dist: &ParameterDistribution,
     method: chatter_stability::monodromy::Discretization,
+    rule: BoundRule,
     speeds: &[f64],
     depths: &[f64],
 ) -> Result<(String, [Series; 3])> {
@@ -336,7 +417,7 @@ pub fn credibility_bands(
         speeds,
         depths,
     )?;
-    let bounds = grid.bounds();
+    let bounds = grid.bounds(rule);
     let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm\n");
     for b in &bounds {
         let _ = writeln!(
@@ -351,18 +432,29 @@ pub fn credibility_bands(
     let pick = |f: fn(&chatter_uncertainty::perturbation::CredibilityPoint) -> Option<f64>| {
         bounds
             .iter()
-            .filter_map(|b| f(b).map(|d| (b.speed_rpm, d)))
+            .map(|b| (b.speed_rpm, f(b).unwrap_or(f64::NAN)))
             .collect::<Vec<_>>()
+    };
+    let (mean, lower, upper) = match rule {
+        BoundRule::ComplexSd => (
+            "mean |E mu| = 1".to_string(),
+            "lower: |E mu| + sd = 1".to_string(),
+            "upper: |E mu| - sd = 1".to_string(),
+        ),
+        BoundRule::Coverage(c) => {
+            let p = 100.0 * c;
+            (
+                "mean E|mu| = 1".to_string(),
+                format!("lower ({p:.0} %)"),
+                format!("upper ({p:.0} %)"),
+            )
+        }
     };
     let series = band_series(
         pick(|b| b.depth_mm),
         pick(|b| b.lower_mm),
         pick(|b| b.upper_mm),
-        [
-            "mean |mu| = 1",
-            "|E mu| + sd = 1 (lower)",
-            "|E mu| - sd = 1 (upper)",
-        ],
+        [&mean, &lower, &upper],
     );
     Ok((csv, series))
 }

@@ -299,7 +299,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     folder.add(
         "turning_lobes.svg",
         line_chart_svg(
-            "Seed 000 turning tool: nominal lobes (FDM) and test cuts",
+            "Turning tool of 000 (Table 1 hammer modes): FDM lobes and test cuts",
             "spindle speed (rpm)",
             "width of cut (mm)",
             &[Series {
@@ -321,31 +321,20 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         serde_json::json!([at(6950.0), at(7150.0), at(7300.0), at(7500.0)]),
     );
 
-    // 2. Credibility bounds of the same case with the posterior covariance of Eq. 34 (written
-    //    out as a covariance file that `chatter bands --covariance` reads).
-    stage(2, "credibility bounds with the Eq. 34 covariance");
-    let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
-    let eq34 = vec![
-        vec![3.5e-7, -2.9e-5, -1.5e-5],
-        vec![-2.9e-5, 0.0042, 0.0019],
-        vec![-1.5e-5, 0.0019, 9.4e-4],
-    ];
-    let file = serde_json::json!({"parameter_names": names, "covariance": eq34});
-    folder.add("eq34_covariance.json", serde_json::to_string_pretty(&file)?);
-    let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
-    let dist = chatter_uncertainty::parameters::ParameterDistribution::new(
-        &names,
-        vec![0.0; 3],
-        eq34,
-        None,
-        &folder.path_of("eq34_covariance.json"),
-    )?;
+    // 2. Credibility bounds of the same case after updating (000 Section 6.4, Fig. 8): the
+    //    model at the posterior mean of Eq. 34's distribution with its covariance (written out
+    //    as a covariance file that `chatter bands --covariance` reads).
+    stage(2, "credibility bounds after updating (Eq. 34)");
+    let dist = eq34_distribution(&mut folder)?;
+    let updated = dist.mean_model(&turning)?;
     let coarse: Vec<f64> = (0..=36).map(|i| 6800.0 + 25.0 * i as f64).collect();
-    let depths: Vec<f64> = (0..=60).map(|j| 1.0 + 0.05 * j as f64).collect();
+    let updated_lobes = compute_lobes(&updated, Method::Fdm, &coarse, quiet)?;
+    let depths = lobe_covering_depths(&updated_lobes)?;
     let (csv, series) = crate::bands::credibility_bands(
-        &turning,
+        &updated,
         &dist,
         chatter_stability::monodromy::Discretization::full(),
+        chatter_uncertainty::perturbation::BoundRule::ComplexSd,
         &coarse,
         &depths,
     )?;
@@ -353,7 +342,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     folder.add(
         "turning_credibility.svg",
         line_chart_svg(
-            "Seed 000 turning tool: credibility bounds with the Eq. 34 covariance",
+            "Turning tool of 000 after updating: lobes at the Eq. 34 posterior mean, |E mu| +- 1 sd",
             "spindle speed (rpm)",
             "width of cut (mm)",
             &series,
@@ -372,10 +361,11 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         .map(|p| (p.speed_rpm, p.depth_mm()))
         .collect();
     let bands = type_b_offsets(&curve, TypeBOffsets::new(100.0, 0.2)?)?;
+    folder.add("milling_bands.csv", crate::bands::geometric_csv(&bands));
     folder.add(
         "milling_bands.svg",
         line_chart_svg(
-            "Seed 001 milling example: zero-order lobes with Type B offsets",
+            "Milling example of 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm)",
             "spindle speed (rpm)",
             "axial depth (mm)",
             &crate::bands::band_series(
@@ -387,6 +377,9 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             None,
         )?,
     );
+    for (suffix, svg) in crate::bands::theta_distance_svgs(&bands)? {
+        folder.add(format!("milling_bands-{suffix}.svg"), svg);
+    }
     folder.add("milling_frf.csv", frf_csv(&milling, 0.0, 1500.0, 301, 0, 0));
 
     // 4. Sim-to-real gap: a synthetic shop-floor campaign of a milling machine whose process
@@ -448,6 +441,43 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The posterior of 000 Section 6.4: mean [0.0067, 0.1385, 0.0549] and covariance (Eq. 34) of
+/// theta_omega_2, theta_zeta_2, theta_phi_2, written to `eq34_covariance.json` in `out_dir`.
+fn eq34_distribution(
+    folder: &mut crate::output::Folder,
+) -> Result<chatter_uncertainty::parameters::ParameterDistribution> {
+    let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
+    let mean = vec![0.0067, 0.1385, 0.0549];
+    let eq34 = vec![
+        vec![3.5e-7, -2.9e-5, -1.5e-5],
+        vec![-2.9e-5, 0.0042, 0.0019],
+        vec![-1.5e-5, 0.0019, 9.4e-4],
+    ];
+    let file = serde_json::json!({"parameter_names": names, "covariance": eq34, "mean": mean});
+    folder.add("eq34_covariance.json", serde_json::to_string_pretty(&file)?);
+    let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    Ok(chatter_uncertainty::parameters::ParameterDistribution::new(
+        &names,
+        mean,
+        eq34,
+        None,
+        &folder.path_of("eq34_covariance.json"),
+    )?)
+}
+
+/// Depths (mm) from half the lowest to 1.4 times the highest finite limit of `lobes`, 0.025 mm
+/// apart: the credibility contours of every lobe, its top included, lie on the grid.
+fn lobe_covering_depths(lobes: &[LobePoint]) -> Result<Vec<f64>> {
+    let finite = lobes.iter().map(|p| p.depth_mm()).filter(|d| d.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(d), b.max(d)));
+    if !(lo.is_finite() && hi > 0.0) {
+        bail!("no finite limiting depth to cover");
+    }
+    let (from, to, step) = (0.5 * lo, 1.4 * hi, 0.025);
+    let n = ((to - from) / step).ceil() as usize;
+    Ok((0..=n).map(|j| from + step * j as f64).collect())
 }
 
 /// `chatter simulate`: a simulated cut as signals CSV (header = channel names, first channel the

@@ -15,6 +15,7 @@ mod plan;
 mod plot;
 mod progress;
 mod rcsa;
+mod sensitivity;
 mod update;
 mod validate;
 
@@ -116,8 +117,8 @@ enum Command {
         /// Model file.
         #[arg(long)]
         model: PathBuf,
-        /// Band kind: geometric (Type B offsets, seed 001), perturbation (second-order
-        /// credibility bounds, seed 000) or montecarlo (probability of stability, seed 004).
+        /// Band kind: geometric (Type B offsets in speed and depth), perturbation (credibility
+        /// bounds from a parameter covariance) or montecarlo (probability of stability).
         #[arg(long, value_enum, default_value = "geometric")]
         kind: BandKind,
         /// Stability method; default zoa for geometric, fdm otherwise.
@@ -148,6 +149,10 @@ enum Command {
         /// Seed of the Monte Carlo draws; default 0.
         #[arg(long)]
         seed: Option<u64>,
+        /// Perturbation: bounds of this central credibility of |mu| (e.g. 0.95) instead of the
+        /// paper's |E mu| +- one standard deviation of the complex mu.
+        #[arg(long)]
+        coverage: Option<f64>,
         /// Observed cuts to draw.
         #[arg(long)]
         observations: Option<PathBuf>,
@@ -222,6 +227,9 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Sensitivity |d mu / d theta| of the dominant pole at one cut (000 Table 3) as JSON, on
+    /// the one-step map of the full discretization (or the period map).
+    Sensitivity(sensitivity::SensitivityArgs),
     /// Bayesian model updating: posterior.csv, summary.json, updated_model.json, evidence and
     /// corner plots in --out.
     Update(update::UpdateArgs),
@@ -342,6 +350,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             covariance,
             samples,
             seed,
+            coverage,
             observations,
             out,
             map_out,
@@ -357,6 +366,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             covariance: covariance.as_deref(),
             samples,
             seed,
+            coverage,
             observations: observations.as_deref(),
             out: out.as_deref(),
             map_out: map_out.as_deref(),
@@ -425,6 +435,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             },
             folds.is_some(),
         ),
+        Command::Sensitivity(args) => sensitivity::run(&args),
         Command::Update(args) => update::run(&args, quiet),
         Command::Plan(args) => plan::run(&args, quiet),
         Command::Detect(args) => detect::run(&args),

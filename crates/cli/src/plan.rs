@@ -59,6 +59,9 @@ pub struct PlanArgs {
     /// Seed of the prior samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Cap on test cuts: `stop` is true once this many cuts were made.
+    #[arg(long, default_value_t = chatter_updating::plan::DEFAULT_MAX_TESTS)]
+    max_tests: usize,
 }
 
 struct PathProgress(Bar);
@@ -144,10 +147,18 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         }),
         feed_per_tooth_m: args.feed_per_tooth_mm * 1e-3,
         seed: args.seed,
+        max_tests: args.max_tests,
     };
     let progress = PathProgress(Bar::new(args.paths as u64, "sampled boundaries", quiet));
     let outcome = plan_next_cut(&model, &observations, &settings, &progress)?;
     progress.0.finish();
+    if let Some(t) = outcome.next_cut.filter(|t| t.on_contour == Some(false)) {
+        eprintln!(
+            "warning: the P_s = {} contour at {} rpm lies above the deepest candidate depth; \
+             proposing {} mm there (P_s {:.3}), not a cut on the contour: give deeper --depths",
+            settings.p_test, t.speed_rpm, t.depth_mm, t.p_stable
+        );
+    }
     let strategy = match args.strategy {
         StrategyArg::Voi => "voi",
         StrategyArg::Mrr => "mrr",

@@ -4,7 +4,8 @@ use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use std::path::Path;
 
-/// A named polyline.
+/// A named polyline; a point with a non-finite coordinate breaks the line (nothing is drawn
+/// across it).
 pub struct Series {
     /// Legend label.
     pub label: String,
@@ -82,12 +83,8 @@ pub fn line_chart_svg(
             .map_err(|e| anyhow!("{e}"))?;
         for s in series {
             let color = s.color;
-            let pts: Vec<(f64, f64)> = s
-                .points
-                .iter()
-                .copied()
-                .filter(|p| p.0.is_finite() && p.1.is_finite())
-                .collect();
+            let finite = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite();
+            let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(finite).collect();
             if s.dashed {
                 chart
                     .draw_series(pts.iter().map(|&p| Circle::new(p, 1, color.filled())))
@@ -95,8 +92,11 @@ pub fn line_chart_svg(
                     .label(s.label.clone())
                     .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
             } else {
+                let pieces = s.points.split(|p| !finite(p)).filter(|r| !r.is_empty());
                 chart
-                    .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+                    .draw_series(
+                        pieces.map(|r| PathElement::new(r.to_vec(), color.stroke_width(2))),
+                    )
                     .map_err(|e| anyhow!("{e}"))?
                     .label(s.label.clone())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));

@@ -48,12 +48,29 @@ pub struct UpdateArgs {
     /// Samples per class.
     #[arg(long, default_value_t = 5000)]
     samples: usize,
+    /// Milling poles (002): `gp` replaces the exact monodromy eigenvalues by the Matérn GP
+    /// surrogate of 002 Section 2.2, trained on the exact model over the prior box; `exact`
+    /// computes them for every sample. Default: gp for milling poles (the only data it applies to).
+    #[arg(long, value_enum)]
+    surrogate: Option<SurrogateArg>,
+    /// Training points of the GP surrogate (Halton points of the prior box).
+    #[arg(long, default_value_t = chatter_updating::surrogate::DEFAULT_TRAINING_POINTS)]
+    surrogate_points: usize,
     /// Seed.
     #[arg(long)]
     seed: u64,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
+}
+
+/// Likelihood evaluation of milling poles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SurrogateArg {
+    /// Matérn GP surrogate of the dominant multiplier (002 Section 2.2).
+    Gp,
+    /// The exact monodromy eigenvalue for every sample.
+    Exact,
 }
 
 /// Progress: one step per model class.
@@ -78,8 +95,9 @@ impl ClassObserver for ClassProgress {
 }
 
 /// What `--out` of `chatter update` may hold.
-pub const FILES: [&str; 5] = [
+pub const FILES: [&str; 6] = [
     "posterior.csv",
+    "poles.csv",
     "summary.json",
     "updated_model.json",
     "evidence.svg",
@@ -133,7 +151,18 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             .transpose()?,
         priors,
         classes: args.classes.as_deref().map(parse_classes).transpose()?,
+        surrogate_training_points: match args.surrogate {
+            Some(SurrogateArg::Gp) | None => Some(args.surrogate_points),
+            Some(SurrogateArg::Exact) => None,
+        },
     };
+    crate::validate::count(
+        "--surrogate-points",
+        args.surrogate_points,
+        10,
+        1_000_000,
+        "GP training points",
+    )?;
     let job = UpdateJob::new(&model, &observations, &settings)?;
     if args.classes.is_some() && job.alphas().is_empty() {
         bail!(
@@ -168,13 +197,47 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             );
         }
     }
-    write_outputs(folder, &result, &model)
+    if let Some(s) = &result.surrogate {
+        eprintln!(
+            "GP surrogate ({} training points): held-out pole errors rms {:.3} Hz / {:.2e} \
+             damping (max {:.3} Hz / {:.2e}); |ln L error| at {} posterior samples mean {:.3}, \
+             max {:.3}",
+            s.held_out.training_points,
+            s.held_out.rms_frequency_error_hz,
+            s.held_out.rms_damping_error,
+            s.held_out.max_frequency_error_hz,
+            s.held_out.max_damping_error,
+            s.posterior_points,
+            s.mean_abs_ln_likelihood_error,
+            s.max_abs_ln_likelihood_error
+        );
+    }
+    for p in &result.prior_bound_pileups {
+        eprintln!(
+            "warning: {}: {:.0} % of the posterior lies at the {} bound {} of its prior (median \
+             {:.4e}): the prior decides this parameter, not the data; widen it with --priors",
+            p.parameter,
+            100.0 * p.share_at_bound,
+            match p.bound {
+                chatter_updating::prior_bounds::Bound::Lower => "lower",
+                chatter_updating::prior_bounds::Bound::Upper => "upper",
+            },
+            p.bound_value,
+            p.posterior_median
+        );
+    }
+    let prior = job.prior_draws(PRIOR_DRAWS, args.seed);
+    write_outputs(folder, &result, &model, &prior)
 }
+
+/// Prior draws shown in the corner plot.
+const PRIOR_DRAWS: usize = 2000;
 
 fn write_outputs(
     mut out: Folder,
     r: &UpdateResult,
     nominal: &chatter_dynamics::ModalModel,
+    prior: &[Vec<f64>],
 ) -> Result<()> {
     // posterior.csv: one row per sample, the parameters then the sample weight
     let mut csv = r.parameter_names.join(",") + ",weight\n";
@@ -183,6 +246,26 @@ fn write_outputs(
         csv += &format!("{},{w:e}\n", row.join(","));
     }
     out.add("posterior.csv", csv);
+    if !r.pole_table.is_empty() {
+        let mut t = String::from(
+            "speed_rpm,depth_mm,identified_hz,identified_damping,nominal_hz,nominal_damping,\
+             updated_hz,updated_damping\n",
+        );
+        for p in &r.pole_table {
+            t += &format!(
+                "{},{},{},{},{},{},{},{}\n",
+                p.speed_rpm,
+                p.depth_mm,
+                p.identified_hz,
+                p.identified_damping,
+                p.nominal_hz,
+                p.nominal_damping,
+                p.updated_hz,
+                p.updated_damping
+            );
+        }
+        out.add("poles.csv", t);
+    }
     let n = r.posterior_covariance.nrows();
     let covariance: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| r.posterior_covariance[(i, j)]).collect())
@@ -193,6 +276,8 @@ fn write_outputs(
         "posterior_covariance": covariance,
         "classes": r.classes,
         "selected_alpha": r.selected_alpha,
+        "prior_bound_pileups": r.prior_bound_pileups,
+        "surrogate": r.surrogate,
     });
     out.add(
         "summary.json",
@@ -205,7 +290,7 @@ fn write_outputs(
     let updated = r.updated_model.with_name(Some(name));
     out.add("updated_model.json", updated.to_json_string() + "\n");
     out.add("evidence.svg", evidence_plot(r)?);
-    out.add("corner.svg", corner_plot(r)?);
+    out.add("corner.svg", corner_plot(r, prior)?);
     out.commit().map(drop)
 }
 
@@ -218,32 +303,66 @@ fn padded(lo: f64, hi: f64) -> (f64, f64) {
     (lo - 0.05 * span, hi + 0.05 * span)
 }
 
-/// Log-evidence against log2(alpha) (000 Fig. 4a).
+/// Model classes against log2(alpha): (a) the log-evidence with the two terms of 000 Eq. 33,
+/// data fit E[ln p(D | theta)] and information gain (Fig. 4a); (b) the class probabilities
+/// p(M | D) of Eq. 32 (Fig. 4b).
 fn evidence_plot(r: &UpdateResult) -> Result<String> {
-    let pts: Vec<(f64, f64)> = r
+    let classes: Vec<_> = r
         .classes
         .iter()
-        .filter_map(|c| c.alpha.map(|a| (a.log2(), c.log_evidence)))
-        .filter(|p| p.1.is_finite())
+        .filter_map(|c| c.alpha.map(|a| (a.log2(), c)))
+        .filter(|p| p.1.log_evidence.is_finite())
         .collect();
-    let (x0, x1) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
-        (a.0.min(p.0), a.1.max(p.0))
-    });
-    let (y0, y1) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
-        (a.0.min(p.1), a.1.max(p.1))
-    });
+    let curve = |f: &dyn Fn(&chatter_updating::update::ClassSummary) -> Option<f64>| {
+        classes
+            .iter()
+            .filter_map(|(x, c)| f(c).filter(|v| v.is_finite()).map(|v| (*x, v)))
+            .collect::<Vec<_>>()
+    };
+    let terms = [
+        (
+            "ln p(D | M) (evidence)",
+            curve(&|c| Some(c.log_evidence)),
+            BLUE,
+        ),
+        (
+            "E[ln p(D | theta, M)] (data fit)",
+            curve(&|c| c.data_fit),
+            GREEN,
+        ),
+        (
+            "E[ln posterior / prior] (information gain)",
+            curve(&|c| c.information_gain),
+            RED,
+        ),
+    ];
+    let probabilities = curve(&|c| Some(c.probability));
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (800, 500)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (800, 800)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        if pts.is_empty() {
+        if classes.is_empty() {
             root.titled("no model classes (cut likelihood)", ("sans-serif", 20))
                 .map_err(plot_err)?;
         } else {
-            let (x0, x1) = padded(x0, x1);
+            let (top, bottom) = root.split_vertically(480);
+            let (x0, x1) = padded(
+                classes.iter().map(|c| c.0).fold(f64::INFINITY, f64::min),
+                classes
+                    .iter()
+                    .map(|c| c.0)
+                    .fold(f64::NEG_INFINITY, f64::max),
+            );
+            let ys = terms.iter().flat_map(|t| t.1.iter().map(|p| p.1));
+            let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
+                (a.0.min(y), a.1.max(y))
+            });
             let (y0, y1) = padded(y0, y1);
-            let mut chart = ChartBuilder::on(&root)
-                .caption("Model evidence per class", ("sans-serif", 20))
+            let mut chart = ChartBuilder::on(&top)
+                .caption(
+                    "(a) Model evidence per class and its two terms (Eq. 33)",
+                    ("sans-serif", 18),
+                )
                 .margin(15)
                 .x_label_area_size(40)
                 .y_label_area_size(70)
@@ -252,14 +371,47 @@ fn evidence_plot(r: &UpdateResult) -> Result<String> {
             chart
                 .configure_mesh()
                 .x_desc("log2(alpha)")
-                .y_desc("ln p(D | M)")
+                .y_desc("nats")
+                .draw()
+                .map_err(plot_err)?;
+            for (label, pts, color) in &terms {
+                let color = *color;
+                chart
+                    .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                    .map_err(plot_err)?
+                    .label(*label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                    .map_err(plot_err)?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(plot_err)?;
+            let width = 0.4 * (x1 - x0) / (classes.len() as f64 + 1.0);
+            let mut chart = ChartBuilder::on(&bottom)
+                .caption(
+                    "(b) Class probabilities p(M | D) (Eq. 32)",
+                    ("sans-serif", 18),
+                )
+                .margin(15)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
+                .build_cartesian_2d(x0..x1, 0.0..1.05)
+                .map_err(plot_err)?;
+            chart
+                .configure_mesh()
+                .x_desc("log2(alpha)")
+                .y_desc("p(M | D)")
                 .draw()
                 .map_err(plot_err)?;
             chart
-                .draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(2)))
-                .map_err(plot_err)?;
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
+                .draw_series(probabilities.iter().map(|&(x, p)| {
+                    Rectangle::new([(x - width, 0.0), (x + width, p)], BLUE.mix(0.6).filled())
+                }))
                 .map_err(plot_err)?;
         }
         root.present().map_err(plot_err)?;
@@ -267,17 +419,33 @@ fn evidence_plot(r: &UpdateResult) -> Result<String> {
     Ok(svg)
 }
 
-/// Histograms on the diagonal, pairwise scatter below it (000 Fig. 5).
-fn corner_plot(r: &UpdateResult) -> Result<String> {
+/// 000 Fig. 5: on the diagonal the posterior histogram of each parameter with the Gaussian of
+/// the posterior mean and standard deviation (the fit of 000 Section 6.4), on the posterior's
+/// range; below it pairwise scatter of prior draws (grey) and posterior samples (blue) on the
+/// range of both.
+fn corner_plot(r: &UpdateResult, prior: &[Vec<f64>]) -> Result<String> {
     let d = r.parameter_names.len();
     let samples = r.samples.samples();
+    let span = |rows: &mut dyn Iterator<Item = f64>| {
+        rows.fold((f64::INFINITY, f64::NEG_INFINITY), |a, x| {
+            (a.0.min(x), a.1.max(x))
+        })
+    };
     let ranges: Vec<(f64, f64)> = (0..d)
         .map(|k| {
-            let (lo, hi) = samples
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |a, s| {
-                    (a.0.min(s[k]), a.1.max(s[k]))
-                });
+            let (lo, hi) = span(&mut samples.iter().map(|s| s[k]));
+            padded(lo, hi)
+        })
+        .collect();
+    let joint: Vec<(f64, f64)> = (0..d)
+        .map(|k| {
+            let (lo, hi) = span(
+                &mut samples
+                    .iter()
+                    .chain(prior)
+                    .map(|s| s[k])
+                    .filter(|x| x.is_finite()),
+            );
             padded(lo, hi)
         })
         .collect();
@@ -302,7 +470,14 @@ fn corner_plot(r: &UpdateResult) -> Result<String> {
                     let b = (((s[j] - x0) / width) as usize).min(bins - 1);
                     counts[b] += w;
                 }
-                let top = counts.iter().copied().fold(0.0, f64::max).max(1e-300);
+                let (m, sd) = (r.posterior_mean[j], r.posterior_covariance[(j, j)].sqrt());
+                let total: f64 = counts.iter().sum();
+                let peak = if sd > 0.0 {
+                    total * width / (sd * (2.0 * std::f64::consts::PI).sqrt())
+                } else {
+                    0.0
+                };
+                let top = counts.iter().copied().fold(peak, f64::max).max(1e-300);
                 let mut chart = ChartBuilder::on(area)
                     .caption(&r.parameter_names[j], ("sans-serif", 12))
                     .margin(6)
@@ -322,8 +497,20 @@ fn corner_plot(r: &UpdateResult) -> Result<String> {
                         Rectangle::new([(left, 0.0), (left + width, c)], BLUE.mix(0.6).filled())
                     }))
                     .map_err(plot_err)?;
+                // the fitted Gaussian, scaled to the histogram's mass per bin
+                if sd > 0.0 {
+                    let curve = (0..=200).map(|q| {
+                        let x = x0 + (x1 - x0) * f64::from(q) / 200.0;
+                        let z = (x - m) / sd;
+                        let pdf = (-0.5 * z * z).exp() / (sd * (2.0 * std::f64::consts::PI).sqrt());
+                        (x, total * width * pdf)
+                    });
+                    chart
+                        .draw_series(LineSeries::new(curve, RED.stroke_width(2)))
+                        .map_err(plot_err)?;
+                }
             } else {
-                let (y0, y1) = ranges[i];
+                let ((x0, x1), (y0, y1)) = (joint[j], joint[i]);
                 let mut chart = ChartBuilder::on(area)
                     .margin(6)
                     .x_label_area_size(20)
@@ -335,6 +522,16 @@ fn corner_plot(r: &UpdateResult) -> Result<String> {
                     .x_labels(3)
                     .y_labels(3)
                     .draw()
+                    .map_err(plot_err)?;
+                chart
+                    .draw_series(
+                        prior
+                            .iter()
+                            .filter(|s| s[j].is_finite() && s[i].is_finite())
+                            .map(|s| {
+                                Circle::new((s[j], s[i]), 1, RGBColor(170, 170, 170).filled())
+                            }),
+                    )
                     .map_err(plot_err)?;
                 let step = (samples.len() / 2000).max(1);
                 chart

@@ -156,6 +156,9 @@ fn demo_writes_its_folder() {
         "turning_lobes.csv",
         "turning_lobes.svg",
         "milling_bands.svg",
+        "milling_bands.csv",
+        "milling_bands-theta.svg",
+        "milling_bands-distance.svg",
         "eq34_covariance.json",
         "turning_credibility.csv",
         "turning_credibility.svg",
@@ -512,6 +515,11 @@ fn update_milling_poles_with_each_sampler_and_rejects_bad_input() {
     ));
     let summary = std::fs::read_to_string(out_dir.join("summary.json")).unwrap();
     assert!(summary.contains("sigma_w2_hz2"), "{summary}");
+    // the GP surrogate is the default for milling poles and reports its errors
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert!(summary["surrogate"]["held_out"]["rms_frequency_error_hz"].is_f64());
+    let poles = std::fs::read_to_string(out_dir.join("poles.csv")).unwrap();
+    assert_eq!(poles.lines().count(), 8, "{poles}");
     // cut results with rejection sampling + adaptive MCMC (004): one class, no alpha
     let cuts = dir.path().join("cuts.csv");
     std::fs::write(
@@ -1054,4 +1062,64 @@ fn oma_overrides_reach_the_identification() {
     assert!(err.contains("min_order"), "{err}");
     let err = fail(chatter().args(base).args(["--segments", "0"]));
     assert!(err.contains("segments"), "{err}");
+}
+
+/// `chatter sensitivity` reproduces 000 Table 3 at P1 (7150 rpm, 2.286 mm) within 3 % on the
+/// one-step map; the period map's derivative is m |mu|^((m-1)/m) times larger.
+#[test]
+fn sensitivity_reproduces_table3_at_p1() {
+    let run = |map: &str| -> serde_json::Value {
+        let text = succeed(
+            chatter()
+                .args(["sensitivity", "--model"])
+                .arg(example("ahmadi2022_turning_model.json"))
+                .args(["--speed-rpm", "7150", "--depth-mm", "2.286", "--map", map])
+                .args(["--parameters", "theta_omega_2,theta_zeta_2,theta_phi_2"]),
+        );
+        serde_json::from_str(&text).unwrap()
+    };
+    let one = run("one-step");
+    assert_eq!(one["steps_per_delay"], 200);
+    let s = one["sensitivities"].as_array().unwrap();
+    for (e, paper) in s.iter().zip([0.3105, 0.0028, 0.0078]) {
+        let m = e["modulus"].as_f64().unwrap();
+        assert!((m - paper).abs() < 0.03 * paper, "{e}");
+    }
+    let period = run("period");
+    let mu = period["eigenvalue"]["modulus"].as_f64().unwrap();
+    let ratio =
+        period["sensitivities"][0]["modulus"].as_f64().unwrap() / s[0]["modulus"].as_f64().unwrap();
+    assert!(
+        (ratio - 200.0 * mu.powf(199.0 / 200.0)).abs() < 1e-6 * ratio,
+        "{ratio}"
+    );
+    let err = fail(
+        chatter()
+            .args(["sensitivity", "--model"])
+            .arg(example("schmitz2023_milling_model.json"))
+            .args(["--speed-rpm", "6000", "--depth-mm", "1"]),
+    );
+    assert!(err.contains("period"), "{err}");
+}
+
+/// Geometric bands carry the raw Eq. 10-11 roots and write the theta and d plots (001 Figs.
+/// 7-10).
+#[test]
+fn geometric_bands_export_raw_roots_and_theta_distance_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let plot = dir.path().join("b.svg");
+    let text = succeed(
+        chatter()
+            .args(["bands", "--quiet", "--kind", "geometric", "--model"])
+            .arg(example("schmitz2023_milling_model.json"))
+            .args(["--speeds", "5000:7000:41", "--plot"])
+            .arg(&plot),
+    );
+    assert!(text.starts_with(
+        "speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance,upper_speed_rpm,\
+         upper_depth_mm,lower_speed_rpm,lower_depth_mm\n"
+    ));
+    for f in ["b.svg", "b-theta.svg", "b-distance.svg"] {
+        assert!(dir.path().join(f).exists(), "{f}");
+    }
 }

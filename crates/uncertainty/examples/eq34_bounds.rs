@@ -37,7 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &speeds_rpm,
             &depths_mm,
         )?;
-        for b in grid.bounds() {
+        for b in grid.bounds(chatter_uncertainty::perturbation::BoundRule::ComplexSd) {
             println!(
                 "{name},{},{},{},{}",
                 b.speed_rpm,

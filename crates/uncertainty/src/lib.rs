@@ -5,6 +5,8 @@
 //! - [`perturbation`]: second-order perturbation mean and variance of the dominant eigenvalue and
 //!   the credibility-bounded lobes (Ahmadi 2022, seed 000, Eq. 14-18).
 //! - [`montecarlo`]: probability-of-stability maps from parameter samples (seed 004, Fig. 2).
+//! - [`sensitivity`]: the dominant pole's sensitivity to the modal parameters on the one-step or
+//!   the period map (seed 000, Section 6.2, Table 3).
 //! - [`parameters`]: parameter distributions from covariance files and posterior folders.
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
@@ -14,5 +16,6 @@ pub mod geometric;
 pub mod montecarlo;
 pub mod parameters;
 pub mod perturbation;
+pub mod sensitivity;
 
 pub use error::{Result, UncertaintyError};

@@ -98,3 +98,41 @@ fn eq34_stable_cuts_lie_below_the_lower_bound() {
         }
     }
 }
+
+/// Seed 000 Section 6.4 / Fig. 8: at the posterior mean of Eq. 34 (the updated model) with the
+/// Eq. 34 covariance, the credibility bounds exist at every speed of the tested range (a depth
+/// grid that covers the lobe tops), lower <= mean <= upper, and at 7300 rpm they bracket the
+/// observed limit: the stable cut at 3.048 mm lies below the lower bound and the chatter cut at
+/// 3.81 mm above the upper one (000 Section 6: the updated SLD predicts every tested speed).
+/// Also with 95 % coverage of |mu|.
+#[test]
+fn updated_bounds_cover_the_range_and_bracket_the_7300_rpm_cuts() {
+    use chatter_uncertainty::perturbation::BoundRule;
+    let model = examples::ahmadi_2022_turning();
+    let (params, eq34) = (mode2_parameters(), eq34());
+    let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549]).unwrap();
+    let speeds: Vec<f64> = (0..10).map(|i| 6800.0 + 100.0 * f64::from(i)).collect();
+    let depths: Vec<f64> = (0..=80).map(|j| 1.5 + 0.05 * f64::from(j)).collect();
+    let grid = model_moment_grid(
+        Discretization::full(),
+        &updated,
+        &params,
+        &eq34,
+        &speeds,
+        &depths,
+    )
+    .unwrap();
+    for rule in [BoundRule::ComplexSd, BoundRule::coverage(0.95).unwrap()] {
+        for b in grid.bounds(rule) {
+            let (lo, mid, up) = (
+                b.lower_mm.unwrap(),
+                b.depth_mm.unwrap(),
+                b.upper_mm.unwrap(),
+            );
+            assert!(lo <= mid && mid <= up, "{rule:?} {b:?}");
+            if b.speed_rpm == 7300.0 {
+                assert!(lo > 3.048 && up < 3.81, "{rule:?} {b:?}");
+            }
+        }
+    }
+}

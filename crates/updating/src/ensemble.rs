@@ -63,6 +63,10 @@ pub struct TestPlan {
     /// Material removal rate (cm^3/min) where the model's geometry gives one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mrr_cm3_per_min: Option<f64>,
+    /// Risk-based test: whether the depth lies on the P_s = P_test contour (false: the contour
+    /// lies above the deepest candidate depth, which is proposed instead, with its P_s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub on_contour: Option<bool>,
 }
 
 /// Material removal rate (cm^3/min) of a cut: milling b a_e f_z N n with a_e the radial width
@@ -471,6 +475,7 @@ impl BoundaryEnsemble {
                 depths_m.iter().map(move |&d| {
                     let (ps, r) = self.reduction_at(p, sd, column, d, index, kernel);
                     TestPlan {
+                        on_contour: None,
                         speed_rpm: column.speed_rpm,
                         depth_mm: d * 1e3,
                         p_stable: ps,
@@ -490,8 +495,12 @@ impl BoundaryEnsemble {
     }
 
     /// The test of maximum material removal rate on the P_s = `p_test` contour (004): for every
-    /// speed the deepest of `depths_m` with P_s >= p_test, then the speed of largest depth x
-    /// speed (the MRR at fixed radial width and feed). None when no grid point reaches p_test.
+    /// speed the contour depth b* = sup{b : P_s(b) >= p_test}, where P_s(b) is the weight of the
+    /// paths whose limiting depth exceeds b (the weighted (1 - p_test) quantile of the path
+    /// limits, so P_s(b*) exceeds p_test by less than the largest path weight), then the speed
+    /// of largest depth x speed (the MRR at fixed radial width and feed). A contour above the
+    /// deepest of `depths_m` is capped there and flagged `on_contour: false`. None when no speed
+    /// has a depth in `depths_m` range with P_s >= p_test.
     pub fn risk_based_test(
         &self,
         depths_m: &[f64],
@@ -504,24 +513,29 @@ impl BoundaryEnsemble {
                 message: format!("{p_test}; expected in (0, 1)"),
             });
         }
+        let ceiling = depths_m.iter().copied().fold(0.0, f64::max);
+        let floor = depths_m.iter().copied().fold(f64::INFINITY, f64::min);
         let p = self.probabilities();
         let mut best: Option<TestPlan> = None;
         for column in &self.columns {
-            let Some((d, ps)) = depths_m
-                .iter()
-                .map(|&d| (d, stable_probability(&p, column, d)))
-                .filter(|(_, ps)| *ps >= p_test)
-                .max_by(|a, b| a.0.total_cmp(&b.0))
-            else {
+            let Some(contour) = contour_depth(&p, column, p_test) else {
                 continue;
             };
+            let (d, on_contour) = if contour > ceiling {
+                (ceiling, false)
+            } else {
+                (contour, true)
+            };
+            if !(d >= floor && d > 0.0) {
+                continue;
+            }
             let better =
                 best.is_none_or(|b| d * column.speed_rpm > b.depth_mm * 1e-3 * b.speed_rpm);
             if better {
                 best = Some(TestPlan {
                     speed_rpm: column.speed_rpm,
                     depth_mm: d * 1e3,
-                    p_stable: ps,
+                    p_stable: stable_probability(&p, column, d),
                     expected_reduction_percent: None,
                     mrr_cm3_per_min: material_removal_rate_cm3_per_min(
                         self.parameterization.nominal(),
@@ -529,11 +543,37 @@ impl BoundaryEnsemble {
                         d,
                         feed_per_tooth_m,
                     ),
+                    on_contour: Some(on_contour),
                 });
             }
         }
         Ok(best)
     }
+}
+
+/// sup{b : P_s(b) >= p_test} for one speed, just below the limit of the path where the
+/// cumulative weight of deeper paths falls under p_test (P_s(b) = weight of paths with limit > b);
+/// None when P_s < p_test already at depth 0.
+fn contour_depth(p: &[f64], column: &Column, p_test: f64) -> Option<f64> {
+    let mut limits: Vec<(f64, f64)> = column
+        .points
+        .iter()
+        .zip(p)
+        .map(|(pt, &w)| (pt.depth_m, w))
+        .filter(|(d, _)| !d.is_nan())
+        .collect();
+    limits.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // above[k] = weight of paths k.. (limits >= limits[k])
+    let mut above = 1.0f64.min(limits.iter().map(|l| l.1).sum());
+    for &(d, w) in &limits {
+        // just below d every path from here on is deeper: P_s = above
+        // (with a round-off margin: a tail weighing exactly p_test still qualifies)
+        if above >= p_test - 1e-12 && above - w < p_test - 1e-12 {
+            return Some(d * (1.0 - 1e-9));
+        }
+        above -= w;
+    }
+    None
 }
 
 /// exp of max-shifted log weights, normalized.
@@ -635,11 +675,16 @@ mod tests {
         let e = small();
         let depths: Vec<f64> = (1..=60).map(|i| i as f64 * 0.1e-3).collect();
         let plan = e.risk_based_test(&depths, 0.5, 0.1e-3).unwrap().unwrap();
-        assert!(plan.p_stable >= 0.5);
+        // on the contour: P_s within one path weight (1/40) above 0.5, below it just deeper
+        assert_eq!(plan.on_contour, Some(true));
+        assert!(
+            plan.p_stable >= 0.5 && plan.p_stable < 0.5 + 1.0 / 40.0 + 1e-9,
+            "{plan:?}"
+        );
         let deeper = e
-            .probability_of_stability(plan.speed_rpm, plan.depth_mm * 1e-3 + 0.1e-3)
+            .probability_of_stability(plan.speed_rpm, plan.depth_mm * 1e-3 * (1.0 + 1e-6))
             .unwrap();
-        assert!(deeper < 0.5 || plan.depth_mm >= 5.99);
+        assert!(deeper < 0.5 - 1e-12, "{deeper}");
         assert!(plan.mrr_cm3_per_min.is_some_and(|m| m > 0.0));
         assert!(e.risk_based_test(&depths, 1.5, 0.1e-3).is_err());
     }

@@ -12,9 +12,25 @@
 //! J_p(theta) = sum_j (w_hat_pj - w_p(theta))^2 / sigma_w^2 + (zeta_hat_pj - zeta_p(theta))^2 / (alpha sigma_w)^2,
 //! ln p(D | theta, M(alpha)) = -1/2 sum_p J_p - N ln(2 pi alpha sigma_w^2),
 //!
-//! N the number of identified poles. Frequencies are in Hz. A table of mean and standard deviation
+//! N the number of identified poles. Frequencies are in Hz.
+//!
+//! Units of alpha: with sigma_w in Hz, alpha = sigma_zeta / sigma_w is per Hz. 002 writes the
+//! frequency as omega and does not state its unit; if its sigma_omega is in rad/s, its alpha is
+//! 2 pi times smaller than the alpha here for the same weighting (alpha_Hz = 2 pi alpha_rad/s),
+//! so its selected classes 0.01 (Section 3.1) and 0.006 (Section 3.2) correspond to 0.063 and
+//! 0.038 here. The class grid of [`crate::defaults::milling_alphas`] (0.001 to 1) spans both
+//! readings.
+//!
+//! 002's simulated poles (Table 1) are not those of its stated simulation model (194 Hz): its
+//! lifted frequencies sit a constant 1.2 Hz from the monodromy poles of that model
+//! (2000 rpm / 0.5 mm: 4.6 Hz in the table, 5.85 Hz at 194 Hz), and the experimental hammer
+//! frequency 195.3 Hz removes the offset (4.63 Hz; 2100 rpm / 0.4 mm: 14.05 against 14.06 Hz),
+//! so the table was most likely simulated with 195.3 Hz. A table of mean and standard deviation
 //! s over n repetitions enters exactly through sum_j (x_j - m)^2 = n (x_mean - m)^2 + (n - 1) s^2.
 //! theta = [model parameters..., sigma_w^2 (Hz^2)].
+//!
+//! With [`MillingPoleLikelihood::with_surrogate`] the multipliers come from a Gaussian-process
+//! surrogate trained on the exact ones ([`crate::surrogate`], 002 Section 2.2) instead.
 //!
 //! Every condition's discretization grid is fixed at the nominal model
 //! ([`Discretization::resolved`]), so that the operator of every theta has the same dimension and
@@ -68,6 +84,7 @@ pub struct MillingPoleLikelihood {
     conditions: Vec<Condition>,
     alpha: f64,
     poles: f64,
+    surrogate: Option<std::sync::Arc<crate::surrogate::PoleSurrogate>>,
 }
 
 impl MillingPoleLikelihood {
@@ -121,7 +138,18 @@ impl MillingPoleLikelihood {
             conditions,
             alpha,
             poles: total,
+            surrogate: None,
         })
+    }
+
+    /// The same likelihood with the multipliers predicted by `surrogate` (trained on this
+    /// likelihood's conditions, [`crate::surrogate::PoleSurrogate::train`]).
+    pub fn with_surrogate(
+        mut self,
+        surrogate: std::sync::Arc<crate::surrogate::PoleSurrogate>,
+    ) -> Self {
+        self.surrogate = Some(surrogate);
+        self
     }
 
     /// Number of sampled parameters (model parameters plus sigma_w^2).
@@ -139,19 +167,34 @@ impl MillingPoleLikelihood {
         &self.parameterization
     }
 
-    /// Predicted (frequency Hz, damping ratio) of the dominant multiplier at every condition, for
-    /// the model parameters `theta_m`.
-    pub fn predicted_poles(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64)>> {
+    /// The exact dominant multiplier of the monodromy operator at every condition, for the model
+    /// parameters `theta_m`.
+    pub fn exact_multipliers(&self, theta_m: &[f64]) -> Result<Vec<DominantMultiplier>> {
         let model = self.parameterization.model(theta_m)?;
         self.conditions
             .iter()
             .map(|c| {
                 let m = condition_model(&model, c.radial_immersion)?;
                 let op = c.solver.monodromy(&m, c.speed_rpm, c.depth_m)?;
-                let mu = DominantMultiplier::new(op.dominant_eigenvalue()?, op.period_s);
-                Ok(multiplier_frequency_damping(&mu))
+                Ok(DominantMultiplier::new(
+                    op.dominant_eigenvalue()?,
+                    op.period_s,
+                ))
             })
             .collect()
+    }
+
+    /// Predicted (frequency Hz, damping ratio) of the dominant multiplier at every condition, for
+    /// the model parameters `theta_m`: exact, or from the surrogate when there is one.
+    pub fn predicted_poles(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64)>> {
+        match &self.surrogate {
+            Some(s) => s.poles(theta_m),
+            None => Ok(self
+                .exact_multipliers(theta_m)?
+                .iter()
+                .map(multiplier_frequency_damping)
+                .collect()),
+        }
     }
 
     /// ln p(D | theta, M(alpha)) (Eq. 15); -inf where the model cannot be built or its

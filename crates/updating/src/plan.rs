@@ -53,7 +53,13 @@ pub struct PlanSettings {
     pub feed_per_tooth_m: f64,
     /// Seed of the prior samples.
     pub seed: u64,
+    /// Cap on the number of test cuts: the stopping rule fires once this many cuts were made
+    /// (default [`DEFAULT_MAX_TESTS`]).
+    pub max_tests: usize,
 }
+
+/// Default cap on test cuts of a campaign.
+pub const DEFAULT_MAX_TESTS: usize = 10;
 
 impl Default for PlanSettings {
     fn default() -> Self {
@@ -68,6 +74,7 @@ impl Default for PlanSettings {
             depths_m: None,
             feed_per_tooth_m: 0.1e-3,
             seed: 0,
+            max_tests: DEFAULT_MAX_TESTS,
         }
     }
 }
@@ -77,8 +84,12 @@ impl Default for PlanSettings {
 pub struct PlanOutcome {
     /// The next cut (None when no candidate qualifies).
     pub next_cut: Option<TestPlan>,
-    /// The stopping rule fired (the gain of the next cut is small).
+    /// The stopping rule fired (the gain of the next cut is small, or the cap on test cuts is
+    /// reached).
     pub stop: bool,
+    /// Why testing should stop, when it should.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stop_reason: Option<String>,
     /// Cuts used to update the samples.
     pub cuts_used: usize,
     /// Sampled parameter names.
@@ -242,9 +253,33 @@ pub fn plan_next_cut(
             (plan, stop)
         }
     };
+    let capped = observations.cuts.len() >= settings.max_tests;
+    let stop_reason = if capped {
+        Some(format!(
+            "{} cuts made: the cap of {} test cuts is reached",
+            observations.cuts.len(),
+            settings.max_tests
+        ))
+    } else if stop {
+        Some(match settings.strategy {
+            Strategy::ValueOfInformation => {
+                format!("the next cut's expected reduction is below {VOI_STOP_PERCENT} %")
+            }
+            Strategy::MaterialRemovalRate if next_cut.is_none() => {
+                "no candidate reaches P_s >= P_test".to_string()
+            }
+            Strategy::MaterialRemovalRate => format!(
+                "the next cut's MRR is less than {} % above the best stable cut's",
+                100.0 * MRR_STOP_IMPROVEMENT
+            ),
+        })
+    } else {
+        None
+    };
     Ok(PlanOutcome {
         next_cut,
-        stop,
+        stop: stop || capped,
+        stop_reason,
         cuts_used: observations.cuts.len(),
         parameter_names: names,
         posterior_mean: moments.iter().map(|m| m.0).collect(),

@@ -48,6 +48,9 @@ pub struct UpdateSettings {
     pub priors: PriorOverrides,
     /// Model classes alpha.
     pub classes: Option<Vec<f64>>,
+    /// Milling poles: replace the exact multipliers by a GP surrogate trained on this many
+    /// points of the prior box ([`crate::surrogate`], 002 Section 2.2). Ignored otherwise.
+    pub surrogate_training_points: Option<usize>,
 }
 
 /// A validated updating job.
@@ -58,6 +61,8 @@ pub struct UpdateJob {
     names: Vec<String>,
     alphas: Vec<f64>,
     data: Data,
+    surrogate_training_points: Option<usize>,
+    poles: Vec<PoleObservation>,
 }
 
 /// One model class in the result.
@@ -72,6 +77,13 @@ pub struct ClassSummary {
     /// Likelihood evaluations of the sampler that failed numerically (iTMCMC / TMCMC).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub numerical_failures: Option<usize>,
+    /// E[ln p(D | theta, M)] over the posterior: the data fit of 000 Eq. 33 (iTMCMC / TMCMC).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub data_fit: Option<f64>,
+    /// E[ln p(theta | D, M) / p(theta | M)] = data fit - ln p(D | M): the information gain of
+    /// 000 Eq. 33, in nats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub information_gain: Option<f64>,
 }
 
 /// The result of a job.
@@ -91,7 +103,51 @@ pub struct UpdateResult {
     pub selected_alpha: Option<f64>,
     /// The model at the posterior mean of the model parameters.
     pub updated_model: ModalModel,
+    /// Parameters whose posterior piles against a bound of its prior (the prior decides them).
+    pub prior_bound_pileups: Vec<crate::prior_bounds::BoundPileup>,
+    /// The surrogate's errors, when one replaced the exact likelihood.
+    pub surrogate: Option<SurrogateReport>,
+    /// Identified poles against those of the nominal and the updated model (empty for cuts).
+    pub pole_table: Vec<PoleComparison>,
 }
+
+/// An identified pole beside the model's prediction before and after updating.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PoleComparison {
+    /// Spindle speed (rpm).
+    pub speed_rpm: f64,
+    /// Depth or width of cut (mm).
+    pub depth_mm: f64,
+    /// Identified frequency (Hz; lifted principal frequency for milling).
+    pub identified_hz: f64,
+    /// Identified damping ratio.
+    pub identified_damping: f64,
+    /// Nominal model's frequency (Hz).
+    pub nominal_hz: f64,
+    /// Nominal model's damping ratio.
+    pub nominal_damping: f64,
+    /// Updated model's (posterior mean) frequency (Hz).
+    pub updated_hz: f64,
+    /// Updated model's damping ratio.
+    pub updated_damping: f64,
+}
+
+/// How well the GP surrogate stood in for the exact milling likelihood.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SurrogateReport {
+    /// Pole errors of the global surrogate (before refinement) at held-out points of the prior
+    /// box.
+    pub held_out: crate::surrogate::SurrogateCheck,
+    /// Posterior samples of the selected class at which the likelihoods were compared.
+    pub posterior_points: usize,
+    /// Mean |ln L_surrogate - ln L_exact| over those samples.
+    pub mean_abs_ln_likelihood_error: f64,
+    /// Largest |ln L_surrogate - ln L_exact|.
+    pub max_abs_ln_likelihood_error: f64,
+}
+
+/// Posterior samples at which the surrogate's likelihood is compared with the exact one.
+const SURROGATE_POSTERIOR_CHECKS: usize = 50;
 
 impl UpdateJob {
     /// Validate model, observations and settings into a job.
@@ -174,6 +230,8 @@ impl UpdateJob {
             names,
             alphas,
             data,
+            surrogate_training_points: settings.surrogate_training_points,
+            poles: poles.clone(),
         })
     }
 
@@ -192,6 +250,22 @@ impl UpdateJob {
         &self.prior
     }
 
+    /// `n` independent draws from the joint prior (seeded), e.g. to plot beside the posterior
+    /// (000 Fig. 5).
+    pub fn prior_draws(&self, n: usize, seed: u64) -> Vec<Vec<f64>> {
+        use rand::SeedableRng;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                self.prior
+                    .marginals()
+                    .iter()
+                    .map(|m| m.sample(&mut rng))
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Sample every class and summarize the selected one.
     pub fn run(
         &self,
@@ -199,6 +273,7 @@ impl UpdateJob {
         observer: &dyn ClassObserver,
     ) -> Result<UpdateResult> {
         let p = &self.parameterization;
+        let mut surrogate = None;
         let (samples, classes, selected_alpha) = match &self.data {
             Data::Cuts(cuts) => {
                 observer.class_started(0, 1, f64::NAN);
@@ -214,6 +289,8 @@ impl UpdateJob {
                     log_evidence: post.log_evidence,
                     probability: 1.0,
                     numerical_failures: post.numerical_failures,
+                    data_fit: post.data_fit,
+                    information_gain: post.data_fit.map(|f| f - post.log_evidence),
                 };
                 (post.samples, vec![class], None)
             }
@@ -235,21 +312,71 @@ impl UpdateJob {
                 )?)
             }
             Data::MillingPoles(poles) => {
-                let make = |alpha| {
-                    MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())
+                let exact =
+                    MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?;
+                let global = match self.surrogate_training_points {
+                    Some(n) => {
+                        let boxes: Vec<(f64, f64)> = self.prior.marginals()[..p.dimension()]
+                            .iter()
+                            .map(crate::surrogate::prior_box)
+                            .collect();
+                        Some(std::sync::Arc::new(crate::surrogate::PoleSurrogate::train(
+                            &exact, &boxes, n,
+                        )?))
+                    }
+                    None => None,
                 };
-                summarize(select_model_class(
+                let refined = std::sync::Mutex::new(Vec::new());
+                let make = |alpha: f64| {
+                    let like = MillingPoleLikelihood::new(
+                        p.clone(),
+                        poles,
+                        alpha,
+                        Discretization::full(),
+                    )?;
+                    Ok(match &global {
+                        Some(g) => {
+                            let s = crate::surrogate::refined_for_class(
+                                &like,
+                                g.clone(),
+                                &self.prior,
+                                options.samples,
+                                options.seed,
+                            )?;
+                            if let Ok(mut r) = refined.lock() {
+                                r.push((alpha, s.clone()));
+                            }
+                            like.with_surrogate(s)
+                        }
+                        None => like,
+                    })
+                };
+                let (samples, classes, alpha) = summarize(select_model_class(
                     &self.prior,
                     &self.alphas,
                     make,
                     options,
                     observer,
-                )?)
+                )?);
+                let chosen = refined
+                    .into_inner()
+                    .ok()
+                    .and_then(|r| r.into_iter().find(|(a, _)| Some(*a) == alpha));
+                if let (Some((a, g)), Some(global)) = (chosen, &global) {
+                    surrogate = Some(surrogate_report(&g, global, poles, p, a, &samples)?);
+                }
+                (samples, classes, alpha)
             }
         };
         let mean = samples.mean();
         let updated_model = p.model(&mean[..p.dimension()])?;
+        let pole_table = self.pole_table(&mean[..p.dimension()])?;
+        let prior_bound_pileups =
+            crate::prior_bounds::prior_bound_pileups(&self.names, self.prior.marginals(), &samples);
         Ok(UpdateResult {
+            pole_table,
+            prior_bound_pileups,
+            surrogate,
             parameter_names: self.names.clone(),
             posterior_covariance: samples.covariance(),
             posterior_mean: mean,
@@ -259,6 +386,101 @@ impl UpdateJob {
             updated_model,
         })
     }
+}
+
+impl UpdateJob {
+    /// (frequency Hz, damping) of the model's pole at every identified condition for `theta_m`
+    /// (exact: the characteristic root nearest the identified pole in turning, the dominant
+    /// multiplier of the monodromy in milling), in the order of `self.poles`.
+    fn predicted(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64)>> {
+        let p = &self.parameterization;
+        match &self.data {
+            Data::Cuts(_) => Ok(Vec::new()),
+            Data::MillingPoles(poles) => {
+                MillingPoleLikelihood::new(p.clone(), poles, 1.0, Discretization::full())?
+                    .predicted_poles(theta_m)
+            }
+            Data::TurningPoles(expanded) => {
+                let like = TurningPoleLikelihood::new(
+                    p.clone(),
+                    expanded.clone(),
+                    1.0,
+                    ResidualForm::PoleError,
+                )?;
+                let roots = like.predicted_poles(theta_m)?;
+                self.poles
+                    .iter()
+                    .map(|o| {
+                        roots
+                            .iter()
+                            .find(|r| r.0 == o.speed_rpm && (r.1 - o.depth_mm * 1e-3).abs() < 1e-12)
+                            .map(|r| chatter_dynamics::pole::pole_frequency_damping(r.2))
+                            .ok_or_else(|| {
+                                UpdatingError::Observations(format!(
+                                    "no prediction at {} rpm, {} mm",
+                                    o.speed_rpm, o.depth_mm
+                                ))
+                            })
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Identified against predicted poles, nominal and at `theta_m`.
+    fn pole_table(&self, theta_m: &[f64]) -> Result<Vec<PoleComparison>> {
+        if matches!(self.data, Data::Cuts(_)) {
+            return Ok(Vec::new());
+        }
+        let nominal = self.predicted(&self.parameterization.nominal_theta())?;
+        let updated = self.predicted(theta_m)?;
+        Ok(self
+            .poles
+            .iter()
+            .zip(nominal.iter().zip(&updated))
+            .map(|(o, (n, u))| PoleComparison {
+                speed_rpm: o.speed_rpm,
+                depth_mm: o.depth_mm,
+                identified_hz: o.frequency_hz,
+                identified_damping: o.damping_ratio,
+                nominal_hz: n.0,
+                nominal_damping: n.1,
+                updated_hz: u.0,
+                updated_damping: u.1,
+            })
+            .collect())
+    }
+}
+
+/// The surrogate's pole errors at held-out prior points and its likelihood error at posterior
+/// samples of the selected class `alpha`.
+fn surrogate_report(
+    gp: &std::sync::Arc<crate::surrogate::PoleSurrogate>,
+    global: &crate::surrogate::PoleSurrogate,
+    poles: &[PoleObservation],
+    p: &Parameterization,
+    alpha: f64,
+    samples: &SampleSet,
+) -> Result<SurrogateReport> {
+    use rayon::prelude::*;
+    let exact = MillingPoleLikelihood::new(p.clone(), poles, alpha, Discretization::full())?;
+    let approx = exact.clone().with_surrogate(gp.clone());
+    let held_out = global.check(&exact, crate::surrogate::DEFAULT_CHECK_POINTS)?;
+    let all = samples.samples();
+    let step = (all.len() / SURROGATE_POSTERIOR_CHECKS).max(1);
+    let errors: Vec<f64> = all
+        .par_iter()
+        .step_by(step)
+        .map(|t| (approx.ln_likelihood(t) - exact.ln_likelihood(t)).abs())
+        .filter(|e| e.is_finite())
+        .collect();
+    let n = errors.len();
+    Ok(SurrogateReport {
+        held_out,
+        posterior_points: n,
+        mean_abs_ln_likelihood_error: errors.iter().sum::<f64>() / n.max(1) as f64,
+        max_abs_ln_likelihood_error: errors.iter().copied().fold(0.0, f64::max),
+    })
 }
 
 fn summarize(
@@ -273,6 +495,8 @@ fn summarize(
             log_evidence: c.posterior.log_evidence,
             probability,
             numerical_failures: c.posterior.numerical_failures,
+            data_fit: c.posterior.data_fit,
+            information_gain: c.posterior.data_fit.map(|f| f - c.posterior.log_evidence),
         })
         .collect();
     let selected = selection.selected_class();
