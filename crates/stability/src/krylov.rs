@@ -6,7 +6,10 @@
 //! steps until the Krylov decomposition A V_m = V_m B_m + v_{m+1} b^T has `dim` columns. The
 //! Ritz values are the eigenvalues of the small matrix B_m, read off its complex Schur form
 //! B_m = Z T Z^H, reordered by adjacent Givens swaps so that the largest moduli come first. The
-//! dominant Ritz pair (theta, V_m z_1) has the residual |b^T z_1|. When it is not yet converged,
+//! dominant Ritz pair (theta, V_m z_1) has the residual |b^T z_1|; convergence is tested at
+//! several basis sizes with the cheap allocation-free Francis iteration of [`crate::hessenberg`]
+//! on B (reduced to Hessenberg form after a restart), and only a restart computes the Schur
+//! form. When the dominant Ritz pair is not yet converged at `dim`,
 //! the decomposition is truncated to the invariant subspace of B_m that belongs to the `keep`
 //! largest Ritz values (a set closed under conjugation, so that the subspace has a real
 //! orthonormal basis Q): V <- V_m Q, B <- Q^T B_m Q, b^T <- b^T Q, and the next cycle extends
@@ -41,9 +44,9 @@ const KRYLOV_BREAKDOWN: f64 = 1e-12;
 const SCHUR_SWEEPS_PER_ORDER: usize = 100;
 
 /// One Krylov–Schur configuration: the basis size of a cycle, the Ritz values kept over a
-/// restart, the basis sizes within the first cycle at which convergence is tested as well (the
-/// small Schur decomposition costs O(k^3), and most operators converge well before `dim`), the
-/// cycles, and the phase of the start vector.
+/// restart, the basis sizes at which convergence is tested as well (by the allocation-free
+/// Francis iteration, cheap next to the Schur decomposition of a restart; most operators
+/// converge well before `dim`), the cycles, and the phase of the start vector.
 pub(crate) struct KrylovConfig {
     dim: usize,
     keep: usize,
@@ -55,9 +58,9 @@ pub(crate) struct KrylovConfig {
 impl KrylovConfig {
     /// The configuration of every first attempt.
     pub(crate) const DEFAULT: Self = Self {
-        dim: 24,
-        keep: 12,
-        checks: &[8, 12, 16, 20, 24],
+        dim: 40,
+        keep: 20,
+        checks: &[8, 12, 16, 20, 24, 28, 32, 36],
         cycles: 60,
         start_phase: 0.7,
     };
@@ -66,7 +69,7 @@ impl KrylovConfig {
     pub(crate) const FALLBACK: Self = Self {
         dim: 60,
         keep: 30,
-        checks: &[20, 40],
+        checks: &[20, 30, 40, 50],
         cycles: 200,
         start_phase: 2.3,
     };
@@ -365,7 +368,7 @@ pub(crate) fn krylov_schur<F: Fn(&[f64], &mut [f64])>(
                     *vx = wx / beta;
                 }
             }
-            let check = breakdown || kk == m || (kept == 0 && config.checks.contains(&kk));
+            let check = breakdown || kk == m || (kk > kept && config.checks.contains(&kk));
             if !check {
                 continue;
             }
@@ -378,29 +381,28 @@ pub(crate) fn krylov_schur<F: Fn(&[f64], &mut [f64])>(
             let converged = |theta: Complex64, residual: f64| {
                 breakdown || residual <= KRYLOV_TOL * theta.norm().max(1e-300) || settled(theta)
             };
-            if kept == 0 {
-                // a plain Arnoldi cycle: the projected matrix is Hessenberg, and the
-                // allocation-free Francis iteration tests convergence
-                let (theta, x, residual) = hessenberg_ritz_pair(&small, beta)?;
-                if converged(theta, residual) {
-                    return Ok((theta, combine(&basis, x.as_slice())));
-                }
-                if kk < m {
-                    continue;
-                }
+            // the cheap test first: the Francis iteration on the projected matrix (Hessenberg
+            // in a plain Arnoldi cycle, reduced to it after a restart)
+            let (theta, x, residual) = if kept == 0 {
+                hessenberg_ritz_pair(&small, beta)?
+            } else {
+                let (q, h) = small.clone().hessenberg().unpack();
+                let (theta, x, _) = hessenberg_ritz_pair(&h, beta)?;
+                let x = q.map(|v| Complex64::new(v, 0.0)) * x;
+                let residual = beta * x[kk - 1].norm();
+                (theta, x, residual)
+            };
+            if converged(theta, residual) {
+                return Ok((theta, combine(&basis, x.as_slice())));
             }
-            let wanted = if kk == m { keep } else { 1 };
-            let (z, t, placed) = sorted_schur(&small, wanted)?;
-            let theta = t[(0, 0)];
-            let x: Vec<Complex64> = z.column(0).iter().copied().collect();
-            if converged(theta, beta * x[kk - 1].norm()) {
-                return Ok((theta, combine(&basis, &x)));
+            if kk < m {
+                continue;
             }
-            if kk == m {
-                previous = Some(theta);
-                kept = restart(&mut basis, &mut b, &small, &z, placed)?;
-                break;
-            }
+            // restart: keep the Schur vectors of the `keep` largest Ritz values
+            let (z, t, placed) = sorted_schur(&small, keep)?;
+            previous = Some(t[(0, 0)]);
+            kept = restart(&mut basis, &mut b, &small, &z, placed)?;
+            break;
         }
     }
     Err(StabilityError::NoConvergence {
