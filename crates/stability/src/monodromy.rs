@@ -30,8 +30,9 @@
 //! Both become a "step program" y_{i+1} = P_i y_i + R_i q_{i-m} + S_i q_{i-m+1} applied to the
 //! state [y_0; q(t_0 - tau); ...; q(t_{M-1} - tau)] of size 2N + N M: the monodromy operator is a
 //! shift plus these few dense blocks, applied matrix-free in O(M N^2). The dominant multiplier is
-//! found by Krylov–Schur (thick-restart Arnoldi, [`crate::krylov`]) on that operator; the dense matrix is built column by column in
-//! O(M^2 N^3) only when all eigenpairs are needed (sensitivities, cross-checks).
+//! found by Krylov–Schur (Stewart 2002's thick-restart Arnoldi, in the crate's `krylov` module)
+//! on that operator; the dense matrix is built column by column in O(M^2 N^3) only when all
+//! eigenpairs are needed (sensitivities, cross-checks).
 
 use crate::StabilitySolver;
 use crate::eigen::dense_eigenvalues;
