@@ -94,7 +94,8 @@ fn tolerance(solver: Solver, problem: Problem) -> Result<f64, &'static str> {
         (Fdm | Sdm, SdofFull) => Ok(0.005),
         (Fdm | Sdm, SdofFivePercent) => Ok(1e-3),
         (Fdm | Sdm, TwoDofMilling) => Ok(1e-3),
-        // process damping at 300-1000 rpm, measured FDM 0.34 % (1.63 % at m alone); SDM 2.77 %
+        // process damping at 300-1000 rpm, measured FDM 0.31 % (1.63 % at m alone; of which
+        // 0.29 % is the reference's own error at 300 rpm, examples/resolution_accuracy.rs); SDM 2.57 %
         // (7.27 % at m alone, 300 rpm): its step-mean freezing of the velocity term converges
         // slowly there (m to 2m divides its error by 2.2, not 4), so the extrapolation helps less
         (Fdm, ProcessDamping) => Ok(0.005),
