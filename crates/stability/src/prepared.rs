@@ -311,8 +311,10 @@ impl PreparedSolver for PreparedDiscretization {
     /// 1 %), and b = (4 b_2m - b_m) / 3. The first-order schemes' limiting depth
     /// converges as 1/m^2 (`examples/resolution_accuracy.rs`: the error falls by 4.0-4.4 from m
     /// to 2m on the single-DOF benchmark), so the extrapolation removes the leading term: the
-    /// worst error over the benchmark's full immersion at 5000-21 000 rpm goes from 6.0 % to
-    /// 0.2 % (FDM), at the cost of one evaluation on the finer grid per speed.
+    /// worst error over the benchmark's full immersion at 5000-21 000 rpm goes from 6.1 % to
+    /// 0.2 % (FDM; SDM 4.5 % to 0.09 %), at the cost of one or two evaluations on the finer grid
+    /// per speed. Exception: at a crossing of two lobes (5500 rpm there: 1.1 %) the coarse grids
+    /// may put the other lobe lowest, and the dominant lobe alone is extrapolated.
     fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
         let coarse = self.at_speed(speed_rpm)?;
         let solver = WarmStarted {
