@@ -2,12 +2,14 @@
 //! 200-speed FDM lobe diagram at m = 40, the seed-000 turning multiplier at the default
 //! resolution, and the zero-order limiting depth at one speed (seed-001 two-mode milling, seed-000
 //! turning) and over a 200-speed lobe diagram; the same FDM lobe diagram by the prepared solver
-//! (boundary search from the zero-order limit, warm-started Arnoldi).
+//! (boundary search from the zero-order limit, warm-started Arnoldi), and at the automatic
+//! resolution (`Method::Fdm`: extrapolated from m and 2m steps); the multiplier of the 003-type
+//! flexure at 300 rpm with process damping (clustered multipliers, operator dimension 276).
 use chatter_dynamics::examples;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, Silent, lobe_diagram, speed_range};
 use chatter_stability::monodromy::Discretization;
-use chatter_stability::prepared::{PreparedDiscretization, PreparedSolver};
+use chatter_stability::prepared::{Method, PreparedDiscretization, PreparedSolver};
 use chatter_stability::zero_order::{zoa_limiting_depth, zoa_lobes};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -26,6 +28,10 @@ fn bench(c: &mut Criterion) {
     c.bench_function("multiplier_turning_fdm_auto", |b| {
         b.iter(|| Discretization::full().dominant_multiplier(&turning, 7150.0, 2.286e-3))
     });
+    let flexure = examples::process_damping_flexure(Some(2.5e5));
+    c.bench_function("multiplier_flexure_300rpm_fdm_auto", |b| {
+        b.iter(|| Discretization::full().dominant_multiplier(&flexure, 300.0, 2.9e-3))
+    });
     let speeds = speed_range(5000.0, 25_000.0, 200).unwrap_or_default();
     let mut group = c.benchmark_group("lobes");
     group.sample_size(10);
@@ -43,6 +49,12 @@ fn bench(c: &mut Criterion) {
     let prepared = PreparedDiscretization::new(fdm40, &benchmark, &BoundaryOptions::default()).ok();
     group.bench_function("lobes_200_speeds_fdm_m40_prepared", |b| {
         b.iter(|| prepared.as_ref().map(|p| p.lobes(&speeds, &Silent)))
+    });
+    let auto = Method::Fdm
+        .prepare(&benchmark, &BoundaryOptions::default())
+        .ok();
+    group.bench_function("lobes_200_speeds_fdm_auto_prepared", |b| {
+        b.iter(|| auto.as_ref().map(|p| p.lobes(&speeds, &Silent)))
     });
     group.finish();
 }

@@ -134,14 +134,34 @@ pub fn limiting_depth_near<S: StabilitySolver + ?Sized>(
     guess_m: Option<f64>,
     options: &BoundaryOptions,
 ) -> Result<LobePoint> {
+    let Some(bracket) = boundary_bracket_near(solver, model, speed_rpm, guess_m, options)? else {
+        return Ok(LobePoint {
+            speed_rpm,
+            depth_m: f64::INFINITY,
+            chatter_hz: f64::NAN,
+        });
+    };
+    let depth_m = bracket.root();
+    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
+    Ok(LobePoint {
+        speed_rpm,
+        depth_m,
+        chatter_hz,
+    })
+}
+
+/// The search of [`limiting_depth_near`] up to its refined bracket of |mu| - 1 (`None` when
+/// stable up to the ceiling), without the chatter frequency.
+pub(crate) fn boundary_bracket_near<S: StabilitySolver + ?Sized>(
+    solver: &S,
+    model: &ModalModel,
+    speed_rpm: f64,
+    guess_m: Option<f64>,
+    options: &BoundaryOptions,
+) -> Result<Option<Bracket>> {
     options.validate()?;
     let f = |b: f64| -> Result<f64> {
         Ok(solver.dominant_multiplier(model, speed_rpm, b)?.modulus() - 1.0)
-    };
-    let unbounded = LobePoint {
-        speed_rpm,
-        depth_m: f64::INFINITY,
-        chatter_hz: f64::NAN,
     };
     let guess = guess_m
         .filter(|b| b.is_finite() && *b >= options.start_depth_m)
@@ -149,7 +169,7 @@ pub fn limiting_depth_near<S: StabilitySolver + ?Sized>(
     let bracket = match guess {
         Some(b) => match widen_from_guess(&f, b, options)? {
             Widened::Bracket(bracket) => Some(bracket),
-            Widened::Unbounded => return Ok(unbounded),
+            Widened::Unbounded => return Ok(None),
             Widened::BelowStart => None,
         },
         None => None,
@@ -158,17 +178,10 @@ pub fn limiting_depth_near<S: StabilitySolver + ?Sized>(
         Some(bracket) => bracket,
         None => match scan_from_start(solver, &f, speed_rpm, options)? {
             Some(bracket) => bracket,
-            None => return Ok(unbounded),
+            None => return Ok(None),
         },
     };
-    let bracket = illinois(bracket, options.relative_tolerance, MAX_REFINEMENT_STEPS, f)?;
-    let depth_m = bracket.root();
-    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
-    Ok(LobePoint {
-        speed_rpm,
-        depth_m,
-        chatter_hz,
-    })
+    illinois(bracket, options.relative_tolerance, MAX_REFINEMENT_STEPS, f).map(Some)
 }
 
 /// What widening a bracket from a guess found.

@@ -12,6 +12,7 @@ mod eigen;
 pub mod error;
 pub mod frequency_domain;
 mod hessenberg;
+mod krylov;
 pub mod monodromy;
 pub mod multiplier;
 pub mod prepared;

@@ -30,15 +30,18 @@
 //! Both become a "step program" y_{i+1} = P_i y_i + R_i q_{i-m} + S_i q_{i-m+1} applied to the
 //! state [y_0; q(t_0 - tau); ...; q(t_{M-1} - tau)] of size 2N + N M: the monodromy operator is a
 //! shift plus these few dense blocks, applied matrix-free in O(M N^2). The dominant multiplier is
-//! found by restarted Arnoldi on that operator; the dense matrix is built column by column in
-//! O(M^2 N^3) only when all eigenpairs are needed (sensitivities, cross-checks).
+//! found by Krylov–Schur (Stewart 2002's thick-restart Arnoldi, in the crate's `krylov` module)
+//! on that operator; the dense matrix is built column by column in O(M^2 N^3) only when all
+//! eigenpairs are needed (sensitivities, cross-checks).
 
 use crate::StabilitySolver;
-use crate::eigen::{dense_eigenvalues, hessenberg_eigenvalues_robust};
+use crate::eigen::dense_eigenvalues;
 use crate::error::{Result, StabilityError, check_condition};
+pub use crate::krylov::DENSE_FALLBACK_MAX_DIM;
+use crate::krylov::{DENSE_MAX_DIM, largest, robust_eigenpair};
 use crate::multiplier::DominantMultiplier;
 use chatter_dynamics::{ModalModel, Operation};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -171,7 +174,7 @@ impl StabilitySolver for Discretization {
 }
 
 impl Discretization {
-    /// [`StabilitySolver::chatter_frequency_hz`] with Arnoldi started from `start` (see
+    /// [`StabilitySolver::chatter_frequency_hz`] with the Krylov iteration started from `start` (see
     /// [`Monodromy::dominant_eigenpair_from`]).
     pub fn chatter_frequency_from(
         &self,
@@ -696,7 +699,7 @@ impl Monodromy {
         m
     }
 
-    /// The eigenvalue of largest modulus, by restarted Arnoldi on the matrix-free operator
+    /// The eigenvalue of largest modulus, by Krylov–Schur on the matrix-free operator
     /// (dense eigenvalues for tiny operators; see [`Self::dominant_eigenpair`] for the
     /// fallbacks).
     pub fn dominant_eigenvalue(&self) -> Result<Complex64> {
@@ -711,15 +714,15 @@ impl Monodromy {
 impl Monodromy {
     /// The dominant eigenvalue and its (complex) eigenvector.
     ///
-    /// Restarted Arnoldi on the matrix-free operator; when it does not converge, a second run
-    /// with a larger Krylov space, more restarts and another start vector; when that fails too,
+    /// Krylov–Schur on the matrix-free operator; when it does not converge, a second run
+    /// with a larger Krylov space, more cycles and another start vector; when that fails too,
     /// the dense operator (up to [`DENSE_FALLBACK_MAX_DIM`]). Tiny operators go to the dense
     /// solver directly.
     pub fn dominant_eigenpair(&self) -> Result<(Complex64, Vec<Complex64>)> {
         self.dominant_eigenpair_from(None)
     }
 
-    /// [`Self::dominant_eigenpair`] with the first Arnoldi run started from `start` (e.g. the
+    /// [`Self::dominant_eigenpair`] with the first Krylov–Schur run started from `start` (e.g. the
     /// real plus imaginary part of the eigenvector of a nearby operator of the same dimension:
     /// the boundary search at the previous depth), which saves most restarts where the
     /// multipliers cluster in modulus (low speeds). A start of another dimension is ignored.
@@ -798,239 +801,6 @@ impl Monodromy {
     }
 }
 
-/// Largest operator dimension solved densely from the start.
-const DENSE_MAX_DIM: usize = 24;
-/// Largest operator dimension for which a failed Arnoldi iteration falls back to the dense
-/// operator (building it costs `d` applications, its eigenvalues O(d^3): about 0.1 s at 600,
-/// 1.5 s at 1600). Arnoldi stalls on clustered dominant multipliers, e.g. turning with process
-/// damping at long delays, where the semi-discretization at converged resolution (the gap
-/// proving ground's truth) reaches about 1200.
-pub const DENSE_FALLBACK_MAX_DIM: usize = 1600;
-
-/// The dominant eigenpair of the operator `apply` of dimension `d`: dense for tiny operators,
-/// else Arnoldi (from `start` when given), a larger Arnoldi and the dense matrix `dense()` in
-/// turn.
-fn robust_eigenpair<F: Fn(&[f64], &mut [f64])>(
-    apply: F,
-    d: usize,
-    dense: impl Fn() -> DMatrix<f64>,
-    start: Option<&[f64]>,
-) -> Result<(Complex64, Vec<Complex64>)> {
-    if d <= DENSE_MAX_DIM {
-        return dense_eigenpair(dense());
-    }
-    let first = match arnoldi(&apply, d, &ArnoldiConfig::DEFAULT, start) {
-        Ok(pair) => return Ok(pair),
-        Err(e) => e,
-    };
-    if let Ok(pair) = arnoldi(&apply, d, &ArnoldiConfig::FALLBACK, None) {
-        return Ok(pair);
-    }
-    if d <= DENSE_FALLBACK_MAX_DIM {
-        return dense_eigenpair(dense());
-    }
-    Err(first)
-}
-
-/// Dominant eigenvalue of a small dense matrix and its eigenvector by inverse iteration.
-fn dense_eigenpair(dense: DMatrix<f64>) -> Result<(Complex64, Vec<Complex64>)> {
-    let d = dense.nrows();
-    let mu = largest(&dense_eigenvalues(&dense)?)?;
-    let shift = mu * Complex64::new(1.0 + 1e-10, 0.0);
-    let lu = (dense.map(|x| Complex64::new(x, 0.0)) - DMatrix::identity(d, d) * shift).lu();
-    let mut x = DVector::from_element(d, Complex64::new(1.0, 0.0));
-    for _ in 0..3 {
-        if let Some(s) = lu.solve(&x) {
-            let nrm = s.norm();
-            x = s / Complex64::new(nrm, 0.0);
-        }
-    }
-    Ok((mu, x.iter().copied().collect()))
-}
-
-/// The eigenvalue of largest modulus; of a complex-conjugate pair, the member with Im >= 0.
-fn largest(values: &[Complex64]) -> Result<Complex64> {
-    let finite = || {
-        values
-            .iter()
-            .copied()
-            .filter(|z| z.re.is_finite() && z.im.is_finite())
-    };
-    let top =
-        finite()
-            .map(|z| z.norm())
-            .max_by(f64::total_cmp)
-            .ok_or(StabilityError::NoConvergence {
-                solver: "eigenvalues",
-                detail: "no finite eigenvalue".into(),
-            })?;
-    finite()
-        .filter(|z| z.norm() >= top * (1.0 - 1e-12))
-        .max_by(|a, b| a.im.total_cmp(&b.im))
-        .ok_or(StabilityError::NoConvergence {
-            solver: "eigenvalues",
-            detail: "no finite eigenvalue".into(),
-        })
-}
-
-/// One Arnoldi configuration: Krylov dimension of a cycle, the dimensions within a cycle at
-/// which convergence is tested (the small Hessenberg eigenproblem costs O(k^3), so most operators
-/// stop well before the full dimension), the restarts, and the phase of the start vector.
-struct ArnoldiConfig {
-    dim: usize,
-    checks: &'static [usize],
-    restarts: usize,
-    start_phase: f64,
-}
-
-impl ArnoldiConfig {
-    /// The configuration of every first attempt.
-    const DEFAULT: Self = Self {
-        dim: 20,
-        checks: &[8, 12, 16, 20],
-        restarts: 40,
-        start_phase: 0.7,
-    };
-    /// The second attempt when the first does not converge: twice the Krylov space, three
-    /// times the restarts, another start vector.
-    const FALLBACK: Self = Self {
-        dim: 40,
-        checks: &[10, 20, 30, 40],
-        restarts: 120,
-        start_phase: 2.3,
-    };
-}
-
-/// Relative convergence of the dominant Ritz value between restarts and by residual.
-const ARNOLDI_TOL: f64 = 1e-10;
-/// A new Krylov direction shorter than this fraction of the operator's image counts as a
-/// breakdown (the Krylov space is invariant to round-off): continuing would fill the Hessenberg
-/// matrix with noise.
-const ARNOLDI_BREAKDOWN: f64 = 1e-12;
-
-/// The dominant Ritz pair of the leading kk x kk block of `h`: value, the small eigenvector and
-/// the residual estimate |h_{kk+1,kk} x_kk|.
-fn ritz_pair(h: &DMatrix<f64>, kk: usize) -> Result<(Complex64, DVector<Complex64>, f64)> {
-    let (values, _) = hessenberg_eigenvalues_robust(kk, |i, j| h[(i, j)])?;
-    let theta = largest(&values)?;
-    // Ritz vector of theta by inverse iteration on the small Hessenberg matrix
-    let hc = h.view((0, 0), (kk, kk)).map(|x| Complex64::new(x, 0.0));
-    let shift = theta * Complex64::new(1.0 + 1e-10, 0.0);
-    let lu = (hc - DMatrix::identity(kk, kk) * shift).lu();
-    let mut x = DVector::from_element(kk, Complex64::new(1.0, 0.0));
-    for _ in 0..3 {
-        if let Some(s) = lu.solve(&x) {
-            let nrm = s.norm();
-            x = s / Complex64::new(nrm, 0.0);
-        }
-    }
-    let residual = if kk < h.nrows() {
-        h[(kk, kk - 1)] * x[kk - 1].norm()
-    } else {
-        0.0
-    };
-    Ok((theta, x, residual))
-}
-
-/// Restarted Arnoldi for the eigenvalue of largest modulus of the operator `apply` of dimension
-/// `d`, with its Ritz vector. Convergence is tested at the Krylov dimensions of
-/// `config.checks`; a cycle that reaches `config.dim` restarts from its Ritz vector. The first
-/// cycle starts from `initial` when given (and not zero), else from a fixed vector.
-fn arnoldi<F: Fn(&[f64], &mut [f64])>(
-    apply: F,
-    d: usize,
-    config: &ArnoldiConfig,
-    initial: Option<&[f64]>,
-) -> Result<(Complex64, Vec<Complex64>)> {
-    let k = config.dim.min(d - 1);
-    let mut start: Vec<f64> = match initial {
-        Some(v)
-            if v.iter().any(|x| *x != 0.0 && x.is_finite()) && v.iter().all(|x| x.is_finite()) =>
-        {
-            v.to_vec()
-        }
-        // deterministic start vector
-        _ => (0..d)
-            .map(|i| 1.0 + 0.5 * ((i as f64) * config.start_phase).sin())
-            .collect(),
-    };
-    let mut previous: Option<Complex64> = None;
-    let mut v = vec![vec![0.0; d]; k + 1];
-    let mut w = vec![0.0; d];
-    let ritz_vector = |v: &[Vec<f64>], x: &DVector<Complex64>, kk: usize| -> Vec<Complex64> {
-        (0..d)
-            .map(|i| (0..kk).map(|j| x[j] * v[j][i]).sum())
-            .collect()
-    };
-    for _ in 0..config.restarts {
-        let norm = start.iter().map(|x| x * x).sum::<f64>().sqrt();
-        for (vi, si) in v[0].iter_mut().zip(&start) {
-            *vi = si / norm;
-        }
-        let mut h = DMatrix::<f64>::zeros(k + 1, k);
-        for j in 0..k {
-            apply(&v[j], &mut w);
-            // modified Gram-Schmidt, repeated when it cancels most of w (Daniel, Gragg,
-            // Kaufman and Stewart 1976: reorthogonalize when the norm drops below 1/sqrt(2))
-            let mut norm2 = w.iter().map(|x| x * x).sum::<f64>();
-            let image2 = norm2;
-            if !image2.is_finite() {
-                return Err(StabilityError::NoConvergence {
-                    solver: "Arnoldi",
-                    detail: "the operator overflowed".into(),
-                });
-            }
-            for _ in 0..2 {
-                let before = norm2;
-                for (i, vi) in v.iter().enumerate().take(j + 1) {
-                    let c: f64 = vi.iter().zip(&w).map(|(a, b)| a * b).sum();
-                    h[(i, j)] += c;
-                    for (wx, vx) in w.iter_mut().zip(vi) {
-                        *wx -= c * vx;
-                    }
-                }
-                norm2 = w.iter().map(|x| x * x).sum::<f64>();
-                if norm2 > 0.5 * before {
-                    break;
-                }
-            }
-            let beta = norm2.sqrt();
-            h[(j + 1, j)] = beta;
-            let kk = j + 1;
-            let breakdown = beta < 1e-14 || beta <= ARNOLDI_BREAKDOWN * image2.sqrt();
-            if !breakdown {
-                for (vx, wx) in v[j + 1].iter_mut().zip(&w) {
-                    *vx = wx / beta;
-                }
-            }
-            if !(breakdown || kk == k || config.checks.contains(&kk)) {
-                continue;
-            }
-            let (theta, x, residual) = ritz_pair(&h, kk)?;
-            let settled =
-                previous.is_some_and(|p| (p - theta).norm() <= 1e-3 * ARNOLDI_TOL * theta.norm());
-            if breakdown || residual <= ARNOLDI_TOL * theta.norm().max(1e-300) || settled {
-                return Ok((theta, ritz_vector(&v, &x, kk)));
-            }
-            if kk == k {
-                // restart from the real and imaginary parts of the Ritz vector combined
-                let ritz = ritz_vector(&v, &x, kk);
-                for (s, r) in start.iter_mut().zip(&ritz) {
-                    *s = r.re + r.im;
-                }
-                previous = Some(theta);
-            }
-        }
-    }
-    Err(StabilityError::NoConvergence {
-        solver: "Arnoldi",
-        detail: format!(
-            "{} restarts of a {k}-dimensional Krylov space",
-            config.restarts
-        ),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1090,35 +860,6 @@ mod tests {
                 let left = op.dominant_left_eigenpair().unwrap().0;
                 assert!((left.norm() - right.norm()).abs() < 1e-9 * right.norm());
             }
-        }
-    }
-
-    /// The fallback chain of [`robust_eigenpair`] on an operator (a diagonal one of dimension 60
-    /// with dominant eigenvalue 0.9) that overflows on its first `bad` applications: one bad
-    /// application fails the first Arnoldi run and the second one converges; an operator that
-    /// always overflows fails both and the dense matrix answers. Either way the dominant
-    /// eigenvalue is 0.9 to 1e-10.
-    #[test]
-    fn failed_arnoldi_falls_back() {
-        let d = 60;
-        let diagonal = |i: usize| 0.9 * (1.0 - i as f64 / d as f64);
-        for bad in [1, usize::MAX] {
-            let calls = std::cell::Cell::new(0usize);
-            let apply = |x: &[f64], out: &mut [f64]| {
-                calls.set(calls.get() + 1);
-                for (i, (o, xi)) in out.iter_mut().zip(x).enumerate() {
-                    *o = if calls.get() <= bad {
-                        f64::NAN
-                    } else {
-                        diagonal(i) * xi
-                    };
-                }
-            };
-            assert!(arnoldi(apply, d, &ArnoldiConfig::DEFAULT, None).is_err());
-            calls.set(0);
-            let dense = || DMatrix::from_fn(d, d, |i, j| if i == j { diagonal(i) } else { 0.0 });
-            let (mu, _) = robust_eigenpair(apply, d, dense, None).unwrap();
-            assert!((mu - 0.9).norm() < 1e-10, "{bad}: {mu}");
         }
     }
 

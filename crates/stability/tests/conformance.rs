@@ -15,7 +15,7 @@
 //! about 1.5 times the error measured when they were written (in the comments; the measured
 //! figures are printed by the test). `None` marks a method outside its scope on a problem, with
 //! the reason; such a pair is not run. Solvers that give multipliers must also have |mu| = 1 at
-//! their own boundary (to 1e-3, the search tolerance 1e-4 times the slope of |mu| in depth).
+//! their own boundary (`boundary_multiplier_tolerance`).
 
 #![allow(clippy::unwrap_used)]
 
@@ -86,17 +86,31 @@ fn tolerance(solver: Solver, problem: Problem) -> Result<f64, &'static str> {
         (Zoa, ProcessDamping) => {
             Err("zero-order is 42 % low at 300 rpm with process damping (notes/stab.md)")
         }
-        // the automatic resolution: first order, 24 steps per vibration cycle; measured
-        // turning 0.64 / 0.63 %, full immersion 2.06 / 0.95 % (12 500 rpm), 5 % immersion
-        // 0.14 / 0.07 %, 2-DOF 0.18 / 0.05 %
-        (Fdm | Sdm, Turning) => Ok(0.01),
-        (Fdm | Sdm, SdofFull) => Ok(0.025),
-        (Fdm | Sdm, SdofFivePercent) => Ok(0.0025),
-        (Fdm | Sdm, TwoDofMilling) => Ok(0.003),
-        // process damping at 300-1000 rpm, measured FDM 1.63 %; SDM 7.27 % (300 rpm): its
-        // step-mean freezing of the velocity term converges slowly there
-        (Fdm, ProcessDamping) => Ok(0.025),
-        (Sdm, ProcessDamping) => Ok(0.1),
+        // the automatic resolution (first order, 24 steps per vibration cycle, m) extrapolated
+        // from m and 2m (Richardson, prepared.rs); measured FDM / SDM: turning 0.005 / 0.004 %,
+        // full immersion 0.083 / 0.080 % (at m alone 2.06 / 0.95 %), 5 % immersion
+        // 0.001 / 0.001 %, 2-DOF 0.001 / 0.001 %. Full immersion gets the target, 0.5 %.
+        (Fdm | Sdm, Turning) => Ok(1e-3),
+        (Fdm | Sdm, SdofFull) => Ok(0.005),
+        (Fdm | Sdm, SdofFivePercent) => Ok(1e-3),
+        (Fdm | Sdm, TwoDofMilling) => Ok(1e-3),
+        // process damping at 300-1000 rpm, measured FDM 0.31 % (1.63 % at m alone; of which
+        // 0.29 % is the reference's own error at 300 rpm, examples/resolution_accuracy.rs); SDM 2.57 %
+        // (7.27 % at m alone, 300 rpm): its step-mean freezing of the velocity term converges
+        // slowly there (m to 2m divides its error by 2.2, not 4), so the extrapolation helps less
+        (Fdm, ProcessDamping) => Ok(0.005),
+        (Sdm, ProcessDamping) => Ok(0.04),
+    }
+}
+
+/// How far |mu| may be from 1 at a solver's own boundary: 1e-3 (the search tolerance 1e-4 times
+/// the slope of |mu| in depth), except SDM with process damping, whose extrapolated depth and
+/// extrapolated multiplier disagree by 1.8e-3 at 300 rpm because its error is not yet
+/// quadratic in the step there (see `tolerance`).
+fn boundary_multiplier_tolerance(solver: Solver, problem: Problem) -> f64 {
+    match (solver, problem) {
+        (Solver::Sdm, Problem::ProcessDamping) => 3e-3,
+        _ => 1e-3,
     }
 }
 
@@ -282,7 +296,7 @@ fn every_solver_on_every_reference_problem() {
                     let mu = prepared
                         .dominant_multiplier(point.speed_rpm, point.depth_m)
                         .unwrap();
-                    if (mu.modulus() - 1.0).abs() > 1e-3 {
+                    if (mu.modulus() - 1.0).abs() > boundary_multiplier_tolerance(solver, problem) {
                         failures.push(format!(
                             "{problem:?} {solver:?} {} rpm: |mu| = {} at its own boundary",
                             point.speed_rpm,

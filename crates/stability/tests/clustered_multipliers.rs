@@ -1,0 +1,157 @@
+//! The monodromy eigen-solver where the Floquet multipliers cluster near one modulus (issue 14):
+//! turning and milling with process damping at long delays, where the restart of Arnoldi from
+//! one Ritz vector stalled and the gap proving ground's truth failed. Krylov–Schur must find the
+//! dominant multiplier, checked against computations that do not use it.
+
+#![allow(clippy::unwrap_used)]
+
+use chatter_dynamics::{
+    CuttingCoefficients, ModalModel, Mode, ModeShape, Operation, Turning, examples,
+};
+use chatter_stability::monodromy::Discretization;
+use std::f64::consts::PI;
+
+/// The gap proving ground's lathe (a 640 Hz feed mode and a 700 Hz mode at 30 degrees, 50 mm
+/// workpiece, kt 1500 and kn 600 N/mm^2) with process damping `c_n_per_m`.
+fn proving_ground_lathe(c_n_per_m: f64) -> ModalModel {
+    let feed = Mode::new(
+        640.0,
+        0.03,
+        ModeShape::Directional {
+            coordinate: 0,
+            stiffness_n_per_m: 2.5e7,
+        },
+    )
+    .unwrap();
+    let a = 2.0 * PI * 700.0 / 3e7f64.sqrt();
+    let t = 30f64.to_radians();
+    let oblique = Mode::new(
+        700.0,
+        0.035,
+        ModeShape::MassNormalized([a * t.cos(), a * t.sin()]),
+    )
+    .unwrap();
+    ModalModel::new(
+        None,
+        Operation::Turning(Turning::new(Some(0.05)).unwrap()),
+        CuttingCoefficients::new(1500e6, 600e6).unwrap(),
+        vec![feed, oblique],
+        Some(c_n_per_m),
+    )
+    .unwrap()
+}
+
+/// det D(lambda) of the characteristic equation on the real axis, 2 x 2 in modal coordinates:
+/// D = lambda^2 I + 2 Z Omega lambda + Omega^2 + b W (1 - e^{-lambda tau}) + lambda b P with
+/// W = Phi^T H Phi and P = Phi^T D Phi (the model's constant turning matrices; 000 Eq. 5,
+/// 003 Eq. 1).
+fn characteristic_determinant(model: &ModalModel, speed_rpm: f64, b: f64, lambda: f64) -> f64 {
+    let phi = model.shape_matrix();
+    let w = phi.transpose() * model.directional_matrix(0.0, speed_rpm) * &phi;
+    let p = phi.transpose() * model.process_damping_matrix(0.0, speed_rpm) * &phi;
+    let tau = model.operation().delay_s(speed_rpm);
+    let (omegas, zetas) = (model.omegas_rad_s(), model.damping_ratios());
+    let d = |i: usize, j: usize| {
+        let diagonal = if i == j {
+            lambda * lambda + 2.0 * zetas[i] * omegas[i] * lambda + omegas[i] * omegas[i]
+        } else {
+            0.0
+        };
+        diagonal + b * w[(i, j)] * (1.0 - (-lambda * tau).exp()) + lambda * b * p[(i, j)]
+    };
+    d(0, 0) * d(1, 1) - d(0, 1) * d(1, 0)
+}
+
+/// The conditions where the gap truth (semi-discretization at 3364 steps per delay, operator
+/// dimension 6732) stopped with "40 restarts of a 20-dimensional Krylov space" before
+/// Krylov–Schur: the proving ground's lathe with the process damping of its 1x
+/// (C = 8.78e5 N/m) and 2x (1.76e6 N/m) effects at 1200 rpm. The dominant multiplier there is
+/// real, the quasi-static regeneration (|mu| near b k_c / (k + b k_c)), at the head of a ring of
+/// multipliers e^{lambda_j tau} from the chain of roots spaced 2 pi / tau apart, within 2e-4 of
+/// one modulus. Reference: the largest real root of det D(lambda) = 0 by bisection on the real
+/// axis (no discretization, no Krylov iteration), mu = e^{lambda tau}, to 1e-6 (the
+/// semi-discretization's error at this resolution, 1e-8 against the full discretization at the
+/// same steps). That this real multiplier is the dominant one is checked on the dense operator
+/// of a coarser grid (420 steps, dimension 844) by faer's eigenvalues, to 1e-6.
+#[test]
+fn lathe_with_process_damping_at_low_speed() {
+    let speed = 1200.0;
+    for (c, depth_m) in [
+        (8.779_455e5, 0.05),
+        (1.755_891e6, 0.015),
+        (1.755_891e6, 0.02),
+    ] {
+        let model = proving_ground_lathe(c);
+        let tau = model.operation().delay_s(speed);
+        // bisection for the largest real root: det D > 0 at lambda = 0 (static stiffness) and
+        // changes sign at the quasi-static root
+        let f = |l: f64| characteristic_determinant(&model, speed, depth_m, l);
+        let mut hi = 0.0;
+        let mut lo = -0.5 / tau;
+        while f(lo) > 0.0 {
+            hi = lo;
+            lo *= 2.0;
+        }
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if f(mid) > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let expected = (0.5 * (lo + hi) * tau).exp();
+        let op = Discretization::semi()
+            .with_steps(3364)
+            .monodromy(&model, speed, depth_m)
+            .unwrap();
+        assert_eq!(op.dimension(), 6732);
+        let mu = op.dominant_eigenvalue().unwrap();
+        assert!(
+            (mu - expected).norm() < 1e-6,
+            "C {c:e}, b {depth_m}: {mu} vs {expected}"
+        );
+        if depth_m == 0.015 {
+            let coarse = Discretization::semi()
+                .with_steps(420)
+                .monodromy(&model, speed, depth_m)
+                .unwrap()
+                .dense();
+            let d = coarse.nrows();
+            let top = faer::Mat::<f64>::from_fn(d, d, |i, j| coarse[(i, j)])
+                .eigenvalues()
+                .unwrap()
+                .iter()
+                .map(|z| z.norm())
+                .fold(0.0, f64::max);
+            assert!((top - expected).abs() < 1e-6, "dense {top} vs {expected}");
+        }
+    }
+}
+
+/// The 003-type flexure at 300 rpm (C = 2.5e5 N/m, one tooth, 45 vibration cycles per delay):
+/// FDM at its automatic resolution has a 276-dimensional operator whose multipliers cluster
+/// (1-40 ms per eigenvalue with the old restart). The dominant multiplier must be the largest
+/// modulus of all eigenvalues of the dense operator (faer's dense solver, to 1e-8 relative: the
+/// operator is far from normal) at depths around the limit (2.94 mm).
+#[test]
+fn flexure_at_300_rpm_matches_dense_eigenvalues() {
+    let model = examples::process_damping_flexure(Some(2.5e5));
+    let speed = 300.0;
+    let fdm = Discretization::full();
+    for depth_m in [1e-3, 2.9e-3, 3.5e-3] {
+        let op = fdm.monodromy(&model, speed, depth_m).unwrap();
+        let mu = op.dominant_eigenvalue().unwrap();
+        let dense = op.dense();
+        let d = dense.nrows();
+        let values = faer::Mat::<f64>::from_fn(d, d, |i, j| dense[(i, j)])
+            .eigenvalues()
+            .unwrap();
+        let top = values.iter().map(|z| z.norm()).fold(0.0, f64::max);
+        assert!(
+            (mu.norm() - top).abs() < 1e-8 * top,
+            "b {depth_m} (dimension {d}): {} vs {top}",
+            mu.norm()
+        );
+    }
+}
