@@ -121,18 +121,13 @@ pub fn report_of(
     crate::validate::observations_match(model, observations, r.observations, r.model)?;
     crate::validate::observation_work_size(model, observations, r.observations)?;
     // k-fold splits the entries, speed bands split the distinct speeds
-    let speeds = observations
-        .cuts
-        .iter()
-        .map(|c| c.speed_rpm)
-        .chain(observations.poles.iter().map(|p| p.speed_rpm));
     let (available, what) = match r.validation {
         ValidationArg::Kfold => (
             observations.cuts.len() + observations.poles.len(),
             "cuts and poles",
         ),
         ValidationArg::SpeedBands => {
-            let mut distinct: Vec<f64> = speeds.collect();
+            let mut distinct = observations.speeds_rpm();
             distinct.sort_by(f64::total_cmp);
             distinct.dedup();
             (distinct.len(), "distinct speeds")

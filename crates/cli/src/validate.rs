@@ -245,12 +245,7 @@ pub fn observation_work_size(
     observations: &Observations,
     path: &std::path::Path,
 ) -> Result<()> {
-    let speeds: Vec<f64> = observations
-        .cuts
-        .iter()
-        .map(|c| c.speed_rpm)
-        .chain(observations.poles.iter().map(|p| p.speed_rpm))
-        .collect();
+    let speeds = observations.speeds_rpm();
     work_size(
         model,
         Discretization::full(),

@@ -209,6 +209,15 @@ fn csv_line(error: DynamicsError) -> DynamicsError {
 }
 
 impl Observations {
+    /// The spindle speeds (rpm) of the cuts, then of the poles, in file order.
+    pub fn speeds_rpm(&self) -> Vec<f64> {
+        self.cuts
+            .iter()
+            .map(|c| c.speed_rpm)
+            .chain(self.poles.iter().map(|p| p.speed_rpm))
+            .collect()
+    }
+
     /// Check every entry; an observations set with no entries at all is an error, and so is a
     /// pole given twice (it would count twice in the likelihood).
     pub fn validate(&self) -> Result<()> {

@@ -357,12 +357,7 @@ pub(crate) fn prepare(
     observations: &Observations,
     noise: &NoiseModel,
 ) -> Result<Prepared> {
-    let speeds: Vec<f64> = observations
-        .cuts
-        .iter()
-        .map(|c| c.speed_rpm)
-        .chain(observations.poles.iter().map(|p| p.speed_rpm))
-        .collect();
+    let speeds = observations.speeds_rpm();
     if speeds.is_empty() {
         return Err(GapError::Observations(
             "no cuts and no poles: a diagnosis needs test cuts or identified poles \

@@ -269,39 +269,47 @@ mod tests {
     use rand::SeedableRng;
     use rand_distr::{Distribution, StandardNormal};
 
-    /// mu(theta) = mu0 + d.theta + theta^T D theta / 2 exactly: Eq. 17-18 are then exact for the
-    /// mean, and the variance formula holds for Gaussian theta (Isserlis).
-    #[test]
-    fn moments_match_monte_carlo_for_exact_quadratic() {
-        let mu0 = Complex64::new(0.7, 0.4);
-        let d = DVector::from_vec(vec![Complex64::new(0.3, -0.1), Complex64::new(-0.2, 0.5)]);
-        let h = DMatrix::from_row_slice(
-            2,
-            2,
-            &[
-                Complex64::new(0.8, 0.2),
-                Complex64::new(-0.3, 0.1),
-                Complex64::new(-0.3, 0.1),
-                Complex64::new(0.4, -0.6),
-            ],
-        );
-        let sigma = DMatrix::from_row_slice(2, 2, &[0.04, 0.01, 0.01, 0.09]);
-        let s = EigenSensitivity {
+    /// mu(theta) = mu0 + d.theta + theta^T D theta / 2 with one fixed d and D.
+    fn quadratic(mu0: Complex64) -> EigenSensitivity {
+        EigenSensitivity {
             mu: mu0,
-            gradient: d.clone(),
-            hessian: h.clone(),
-        };
-        let m = moments(&s, &sigma).unwrap();
+            gradient: DVector::from_vec(vec![Complex64::new(0.3, -0.1), Complex64::new(-0.2, 0.5)]),
+            hessian: DMatrix::from_row_slice(
+                2,
+                2,
+                &[
+                    Complex64::new(0.8, 0.2),
+                    Complex64::new(-0.3, 0.1),
+                    Complex64::new(-0.3, 0.1),
+                    Complex64::new(0.4, -0.6),
+                ],
+            ),
+        }
+    }
+
+    /// `n` exact draws of the quadratic mu of `s` for theta ~ N(0, sigma).
+    fn draws(s: &EigenSensitivity, sigma: &DMatrix<f64>, seed: u64, n: usize) -> Vec<Complex64> {
         let chol = sigma.clone().cholesky().unwrap().l();
-        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-        let n = 400_000;
-        let samples: Vec<Complex64> = (0..n)
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        (0..n)
             .map(|_| {
                 let z = DVector::from_fn(2, |_, _| StandardNormal.sample(&mut rng));
                 let t = (&chol * z).map(|v: f64| Complex64::new(v, 0.0));
-                mu0 + (d.transpose() * &t)[(0, 0)] + (t.transpose() * &h * &t)[(0, 0)] * 0.5
+                s.mu + (s.gradient.transpose() * &t)[(0, 0)]
+                    + (t.transpose() * &s.hessian * &t)[(0, 0)] * 0.5
             })
-            .collect();
+            .collect()
+    }
+
+    /// An exact quadratic mu: Eq. 17-18 are then exact for the mean, and the variance formula
+    /// holds for Gaussian theta (Isserlis).
+    #[test]
+    fn moments_match_monte_carlo_for_exact_quadratic() {
+        let s = quadratic(Complex64::new(0.7, 0.4));
+        let sigma = DMatrix::from_row_slice(2, 2, &[0.04, 0.01, 0.01, 0.09]);
+        let m = moments(&s, &sigma).unwrap();
+        let n = 400_000;
+        let samples = draws(&s, &sigma, 7, n);
         let mean: Complex64 = samples.iter().sum::<Complex64>() / n as f64;
         let var: f64 = samples.iter().map(|z| (z - mean).norm_sqr()).sum::<f64>() / n as f64;
         // Monte Carlo standard errors at n = 4e5 are ~1e-3 relative; tolerance 1 %.
@@ -322,36 +330,11 @@ mod tests {
     /// second-order truncation of |mu|), and sd|mu| below the complex sd.
     #[test]
     fn modulus_moments_match_monte_carlo() {
-        let mu0 = Complex64::new(0.6, 0.7);
-        let d = DVector::from_vec(vec![Complex64::new(0.3, -0.1), Complex64::new(-0.2, 0.5)]);
-        let h = DMatrix::from_row_slice(
-            2,
-            2,
-            &[
-                Complex64::new(0.8, 0.2),
-                Complex64::new(-0.3, 0.1),
-                Complex64::new(-0.3, 0.1),
-                Complex64::new(0.4, -0.6),
-            ],
-        );
+        let s = quadratic(Complex64::new(0.6, 0.7));
         let sigma = DMatrix::from_row_slice(2, 2, &[0.004, 0.001, 0.001, 0.009]);
-        let s = EigenSensitivity {
-            mu: mu0,
-            gradient: d.clone(),
-            hessian: h.clone(),
-        };
         let m = modulus_moments(&s, &sigma).unwrap();
-        let chol = sigma.clone().cholesky().unwrap().l();
-        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
         let n = 200_000;
-        let r: Vec<f64> = (0..n)
-            .map(|_| {
-                let z = DVector::from_fn(2, |_, _| StandardNormal.sample(&mut rng));
-                let t = (&chol * z).map(|v: f64| Complex64::new(v, 0.0));
-                (mu0 + (d.transpose() * &t)[(0, 0)] + (t.transpose() * &h * &t)[(0, 0)] * 0.5)
-                    .norm()
-            })
-            .collect();
+        let r: Vec<f64> = draws(&s, &sigma, 11, n).iter().map(|z| z.norm()).collect();
         let mean = r.iter().sum::<f64>() / n as f64;
         let sd = (r.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
         assert!(
