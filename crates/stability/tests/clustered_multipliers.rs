@@ -8,6 +8,7 @@
 use chatter_dynamics::{
     CuttingCoefficients, ModalModel, Mode, ModeShape, Operation, Turning, examples,
 };
+use chatter_stability::StabilitySolver;
 use chatter_stability::monodromy::Discretization;
 use std::f64::consts::PI;
 
@@ -110,6 +111,16 @@ fn lathe_with_process_damping_at_low_speed() {
         assert!(
             (mu - expected).norm() < 1e-6,
             "C {c:e}, b {depth_m}: {mu} vs {expected}"
+        );
+        // the characteristic-root search finds the same real root (it started only on the
+        // imaginary axis before and reported |mu| 0.65 for 0.75)
+        let root = chatter_stability::frequency_domain::FrequencyDomain
+            .dominant_multiplier(&model, speed, depth_m)
+            .unwrap();
+        assert!(
+            (root.modulus() - expected).abs() < 1e-6,
+            "C {c:e}, b {depth_m}: characteristic root {} vs {expected}",
+            root.modulus()
         );
         if depth_m == 0.015 {
             let coarse = Discretization::semi()
