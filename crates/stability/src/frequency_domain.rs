@@ -345,62 +345,6 @@ mod tests {
         );
     }
 
-    /// Two modes (640 Hz along the feed, 700 Hz / 0.035 at 30 degrees) at 2300 rpm: the
-    /// continuation from the damped 700 Hz pole fails (e^{-lambda tau} ~ 55 at its real part,
-    /// Newton wanders), which used to fail the whole call. The grid starts still find the
-    /// dominant root; |mu| = |e^{lambda tau}| agrees with FDM at 4000 steps within 2e-3 (its
-    /// first-order error, measured 3e-4 against SDM at 4x resolution) at 0.5x, 1x and 2x the
-    /// limiting depth.
-    #[test]
-    fn dominant_root_survives_a_failed_continuation() {
-        use crate::boundary::{BoundaryOptions, limiting_depth};
-        use crate::monodromy::Discretization;
-        use chatter_dynamics::{CuttingCoefficients, Mode, ModeShape, Turning};
-        let along = Mode::new(
-            640.0,
-            0.03,
-            ModeShape::Directional {
-                coordinate: 0,
-                stiffness_n_per_m: 2.5e7,
-            },
-        )
-        .unwrap();
-        let (a, t) = (2.0 * PI * 700.0 / 3e7f64.sqrt(), 30f64.to_radians());
-        let oblique = Mode::new(
-            700.0,
-            0.035,
-            ModeShape::MassNormalized([a * t.cos(), a * t.sin()]),
-        )
-        .unwrap();
-        let model = ModalModel::new(
-            None,
-            Operation::Turning(Turning::new(Some(0.05)).unwrap()),
-            CuttingCoefficients::new(1500e6, 600e6).unwrap(),
-            vec![along, oblique],
-            None,
-        )
-        .unwrap();
-        let speed = 2300.0;
-        let fdm = Discretization::full().with_steps(4000);
-        let limit = limiting_depth(&fdm, &model, speed, &BoundaryOptions::default())
-            .unwrap()
-            .depth_m;
-        for ratio in [0.5, 1.0, 2.0] {
-            let exact = FrequencyDomain
-                .dominant_multiplier(&model, speed, ratio * limit)
-                .unwrap()
-                .modulus();
-            let reference = fdm
-                .dominant_multiplier(&model, speed, ratio * limit)
-                .unwrap()
-                .modulus();
-            assert!(
-                (exact - reference).abs() < 2e-3,
-                "x{ratio}: {exact} vs {reference}"
-            );
-        }
-    }
-
     #[test]
     fn milling_is_rejected() {
         let model = examples::schmitz_2023_milling();
