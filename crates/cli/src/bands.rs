@@ -217,11 +217,8 @@ fn geometric(
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "bands".into());
-        for (suffix, svg) in theta_distance_svgs(&bands)? {
-            write_atomic(
-                &path.with_file_name(format!("{stem}-{suffix}.svg")),
-                svg.as_bytes(),
-            )?;
+        for (name, svg) in theta_distance_svgs(&stem, &bands)? {
+            write_atomic(&path.with_file_name(name), svg.as_bytes())?;
         }
     }
     Ok(())
@@ -258,9 +255,9 @@ pub fn geometric_csv(bands: &OffsetBoundaries) -> String {
 }
 
 /// 001 Figs. 7-10: Eq. 2's angle theta and Eq. 1's offset distance d along the mean boundary,
-/// as SVG texts with the suffix of their file names (`theta`, `distance`): `bands --plot F.svg`
-/// writes them beside the plot as `F-theta.svg` and `F-distance.svg`.
-pub fn theta_distance_svgs(bands: &OffsetBoundaries) -> Result<[(&'static str, String); 2]> {
+/// as SVG texts named after the band plot `stem`: `STEM-theta.svg` and `STEM-distance.svg`
+/// (`bands --plot F.svg` writes them beside the plot).
+pub fn theta_distance_svgs(stem: &str, bands: &OffsetBoundaries) -> Result<[(String, String); 2]> {
     let series = |label: &str, f: fn(&chatter_uncertainty::geometric::PointOffset) -> f64| {
         [Series {
             label: label.into(),
@@ -271,7 +268,7 @@ pub fn theta_distance_svgs(bands: &OffsetBoundaries) -> Result<[(&'static str, S
     };
     Ok([
         (
-            "theta",
+            format!("{stem}-theta.svg"),
             line_chart_svg(
                 "Boundary angle along the mean boundary (001 Eq. 2)",
                 "spindle speed (rpm)",
@@ -281,7 +278,7 @@ pub fn theta_distance_svgs(bands: &OffsetBoundaries) -> Result<[(&'static str, S
             )?,
         ),
         (
-            "distance",
+            format!("{stem}-distance.svg"),
             line_chart_svg(
                 "Offset distance along the mean boundary (001 Eq. 1)",
                 "spindle speed (rpm)",

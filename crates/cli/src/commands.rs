@@ -377,8 +377,8 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             None,
         )?,
     );
-    for (suffix, svg) in crate::bands::theta_distance_svgs(&bands)? {
-        folder.add(format!("milling_bands-{suffix}.svg"), svg);
+    for (name, svg) in crate::bands::theta_distance_svgs("milling_bands", &bands)? {
+        folder.add(name, svg);
     }
     folder.add("milling_frf.csv", frf_csv(&milling, 0.0, 1500.0, 301, 0, 0));
 

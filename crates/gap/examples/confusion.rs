@@ -73,6 +73,7 @@ fn main() -> chatter_gap::Result<()> {
     let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
     let magnitudes: Vec<f64> = list("--magnitudes", vec![0.5, 1.0, 2.0]);
     let classes: Vec<EffectClass> = list("--classes", EffectClass::ALL.to_vec());
+    let verbose = std::env::args().any(|a| a == "--verbose");
     let kinds: Vec<String> = list(
         "--cases",
         vec!["control".into(), "effects".into(), "outside".into()],
@@ -168,7 +169,7 @@ fn main() -> chatter_gap::Result<()> {
                 let d = diagnose(&machine.model, &data, &options, &Log(Instant::now()))?;
                 let seconds = start.elapsed().as_secs_f64();
                 times.push(seconds);
-                if std::env::args().any(|a| a == "--verbose") {
+                if verbose {
                     eprintln!(
                         "  nominal ln L {:.1}, nominal check {:?}\n  best check {:?}",
                         d.nominal_log_evidence, d.nominal_check, d.predictive_check
