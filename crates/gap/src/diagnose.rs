@@ -28,7 +28,7 @@ pub(crate) const PREDICTIVE_SAMPLES: usize = 100;
 pub struct DiagnoseOptions {
     /// Seed of every random choice (samplers, folds, replications).
     pub seed: u64,
-    /// iTMCMC samples per class.
+    /// iTMCMC samples per class, times the class's [`EffectClass::population_factor`].
     pub samples: usize,
     /// Metropolis-Hastings steps per chain and stage.
     pub steps: usize,
@@ -44,7 +44,8 @@ pub struct DiagnoseOptions {
     pub min_log_bayes_factor: f64,
     /// Held-out validation of the gap's shrinkage.
     pub validation: Validation,
-    /// iTMCMC samples per class and fold of the validation.
+    /// iTMCMC samples per class and fold of the validation, times the class's
+    /// [`EffectClass::population_factor`].
     pub validation_samples: usize,
     /// The candidate classes (`parameter_error` is always added).
     pub classes: Vec<EffectClass>,
