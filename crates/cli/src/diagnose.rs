@@ -49,7 +49,10 @@ struct Report<'a> {
     validation: Option<&'a chatter_gap::shrink::ValidationReport>,
     predictive_check: &'a chatter_gap::PredictiveCheck,
     nominal_log_evidence: f64,
+    alternative_log_evidence: f64,
     nominal_check: &'a chatter_gap::PredictiveCheck,
+    /// Largest shift of any prediction by the best class, in noise standard deviations.
+    practical_shift_std: f64,
     notes: &'a [String],
 }
 
@@ -190,7 +193,9 @@ pub fn report_of(
         validation: d.validation.as_ref(),
         predictive_check: &d.predictive_check,
         nominal_log_evidence: d.nominal_log_evidence,
+        alternative_log_evidence: d.alternative_log_evidence,
         nominal_check: &d.nominal_check,
+        practical_shift_std: d.practical_shift,
         notes: &d.notes,
     };
     let mut files: Files = Vec::new();

@@ -23,9 +23,11 @@
 //!    after (the winning class fitted to the other folds).
 //!
 //! # Verdicts
-//! `consistent` when the nominal model itself passes the predictive check and no class beats
-//! its likelihood (a class without parameters) by the required Bayes factor; otherwise the best
-//! class when it passes the check; otherwise `unexplained`.
+//! `consistent` when the nominal model itself passes the predictive check and either the classes'
+//! mean evidence does not beat its likelihood (a class without parameters) by a Bayes factor of
+//! 10, or the best class is practically equivalent to it ([`equivalence`]: no observation's
+//! prediction moves by more than one noise standard deviation); otherwise the best class when it
+//! passes the check; otherwise `unexplained`.
 //!
 //! # Model: which approximation is used where
 //! - **Inside the samplers and the checks** every prediction is one Floquet multiplier of the
@@ -65,6 +67,7 @@ mod check;
 pub mod classes;
 mod data;
 pub mod diagnose;
+pub mod equivalence;
 pub mod error;
 pub mod generator;
 pub mod likelihood;
