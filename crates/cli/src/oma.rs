@@ -30,16 +30,12 @@ use crate::plot::{ErrorBarPanel, Series, error_bar_panels, line_chart};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{ModalModel, Observations, Operation, PoleObservation, SignalRecord};
 use chatter_oma::detection::{DetectionOptions, Verdict, detect};
-use chatter_oma::identify::{LIFTED_CRITERIA, LIFTED_MAX_ORDER};
 use chatter_oma::lifting::lift_at_period;
 use chatter_oma::signals::Signals;
 use chatter_oma::spectrum::first_singular_value;
 use chatter_oma::{Decimation, Harmonics, Identification, IdentifyOptions, Lifting, identify};
 use plotters::style::{BLUE, RGBColor};
 use std::path::{Path, PathBuf};
-
-/// Lifted channels kept per physical channel.
-const VIRTUAL_SENSORS: usize = 2;
 
 /// Arguments of `chatter oma`.
 #[derive(Debug, clap::Args)]
@@ -211,34 +207,17 @@ fn analyse(
         Some(Operation::Milling(m)) => Some(m.teeth()),
         _ => None,
     };
-    let (mut options, lifting, method) = match teeth {
-        Some(teeth) => {
-            let lifting = Lifting {
-                period_s: revolution_s / teeth as f64,
-                virtual_sensors: VIRTUAL_SENSORS,
-                periods_per_revolution: teeth,
-            };
-            let options = IdentifyOptions {
-                max_order: LIFTED_MAX_ORDER,
-                criteria: LIFTED_CRITERIA,
-                lifting: Some(lifting),
-                ..IdentifyOptions::default()
-            };
-            let method = format!(
-                "lifted at the tooth period {:.6} s, polyreference",
-                lifting.period_s
-            );
-            (options, Some(lifting), method)
-        }
-        None => {
-            let options = IdentifyOptions {
-                harmonics: Harmonics::Spindle {
-                    fundamental_hz: 1.0 / revolution_s,
-                },
-                ..IdentifyOptions::default()
-            };
-            (options, None, "modified LSCE".to_string())
-        }
+    let mut options = match teeth {
+        Some(teeth) => IdentifyOptions::lifted(revolution_s / teeth as f64, teeth),
+        None => IdentifyOptions::spindle(1.0 / revolution_s),
+    };
+    let lifting = options.lifting;
+    let method = match lifting {
+        Some(l) => format!(
+            "lifted at the tooth period {:.6} s, polyreference",
+            l.period_s
+        ),
+        None => "modified LSCE".to_string(),
     };
     if let Some(n) = args.min_order {
         options.min_order = n;

@@ -229,6 +229,33 @@ impl Default for IdentifyOptions {
     }
 }
 
+impl IdentifyOptions {
+    /// A turning (time-invariant) record: modified LSCE with the spindle harmonics of
+    /// `fundamental_hz` that are spectral lines imposed (000 Sec. 3), the other defaults.
+    pub fn spindle(fundamental_hz: f64) -> Self {
+        Self {
+            harmonics: Harmonics::Spindle { fundamental_hz },
+            ..Self::default()
+        }
+    }
+
+    /// A milling (time-periodic) record: lifted at the tooth period `tooth_period_s` of a
+    /// cutter with `teeth` teeth (2 virtual sensors per channel, the revolution's periodic
+    /// response removed) and polyreference (002 Eq. 6-9), model orders up to
+    /// [`LIFTED_MAX_ORDER`] with [`LIFTED_CRITERIA`].
+    pub fn lifted(tooth_period_s: f64, teeth: usize) -> Self {
+        Self {
+            max_order: LIFTED_MAX_ORDER,
+            criteria: LIFTED_CRITERIA,
+            lifting: Some(Lifting {
+                periods_per_revolution: teeth,
+                ..Lifting::new(tooth_period_s)
+            }),
+            ..Self::default()
+        }
+    }
+}
+
 /// Mean and spread of a pole over repeated identifications.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PoleEstimate {

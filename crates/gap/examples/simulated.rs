@@ -1,0 +1,118 @@
+//! The diagnosis on campaigns observed the way a shop observes them (issue 15, proving ground
+//! part b): every cut simulated in the time domain with loss of contact, spindle harmonics and
+//! 10 % measurement noise, labelled by chatter detection, and (with `--poles`) pole tests
+//! identified by OMA from long stable records (`tests/shop/mod.rs`). A control (the nominal
+//! model is right) and hidden effects at the chosen magnitudes, one campaign each.
+//!
+//! `cargo run --release -p chatter-gap --example simulated [-- --machines 0,3
+//! --classes parameter_error,process_damping --magnitudes 1,2 --cuts 24 --poles --seeds 1]`
+
+#![allow(clippy::unwrap_used)]
+
+#[path = "../tests/shop/mod.rs"]
+mod shop;
+
+use chatter_gap::generator::{effect_at, proving_machines};
+use chatter_gap::{
+    DiagnoseOptions, EffectClass, HiddenEffect, Quiet, Recalibration, Scenario, Validation,
+    diagnose,
+};
+use std::time::Instant;
+
+fn arg(name: &str) -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1).cloned())
+}
+
+fn list<T: std::str::FromStr>(name: &str, default: Vec<T>) -> Vec<T> {
+    arg(name).map_or(default, |s| {
+        s.split(',').filter_map(|x| x.parse().ok()).collect()
+    })
+}
+
+fn main() -> chatter_gap::Result<()> {
+    let machines = proving_machines()?;
+    let pick: Vec<usize> = list("--machines", vec![0, 3]);
+    let classes: Vec<EffectClass> = list(
+        "--classes",
+        vec![EffectClass::ParameterError, EffectClass::ProcessDamping],
+    );
+    let magnitudes: Vec<f64> = list("--magnitudes", vec![1.0, 2.0]);
+    let cuts: usize = arg("--cuts").and_then(|s| s.parse().ok()).unwrap_or(24);
+    let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
+    let poles = std::env::args().any(|a| a == "--poles");
+    let options = DiagnoseOptions {
+        validation: Validation::Off,
+        ..DiagnoseOptions::default()
+    };
+    println!(
+        "machine | case | magnitude | expected | verdict | cuts (chatter) | poles | ln BF vs nominal \
+         | nominal check | practical shift (sd) | seconds"
+    );
+    let (mut right, mut total) = (0, 0);
+    for &mi in &pick {
+        let machine = &machines[mi];
+        let (lo, hi) = machine.speed_range_rpm;
+        let mut cases = vec![(
+            "control".to_string(),
+            "control".to_string(),
+            HiddenEffect::ParameterError,
+            Recalibration::default(),
+        )];
+        for &class in &classes {
+            if class == EffectClass::ProcessDamping
+                && machine.model.operation().cutting_diameter_m().is_none()
+            {
+                continue;
+            }
+            for &m in &magnitudes {
+                let (effect, error) = effect_at(class, m, &machine.model, (lo, hi))?;
+                cases.push((class.name().into(), format!("{m}x"), effect, error));
+            }
+        }
+        for (name, magnitude, effect, error) in cases {
+            for seed in 0..seeds {
+                let start = Instant::now();
+                let pole_speeds = if poles { 4 } else { 0 };
+                let mut scenario =
+                    Scenario::new(effect, 2000 + seed).with_speed_range(lo, hi, pole_speeds);
+                scenario.error = error;
+                scenario.cuts = cuts;
+                scenario.speeds = (cuts / 3).max(1);
+                let data = shop::observe(&machine.model, &scenario, poles);
+                let d = diagnose(
+                    &machine.model,
+                    &data,
+                    &DiagnoseOptions {
+                        seed,
+                        ..options.clone()
+                    },
+                    &Quiet,
+                )?;
+                let expected = effect.expected_verdict(&error);
+                total += 1;
+                right += usize::from(d.verdict.name() == expected);
+                println!(
+                    "{} | {name} | {magnitude} | {expected} | {} | {} ({}) | {} | {:.2} | {} | {:.2} | {:.0}",
+                    machine.name,
+                    d.verdict.name(),
+                    data.cuts.len(),
+                    data.cuts.iter().filter(|c| !c.stable).count(),
+                    data.poles.len(),
+                    d.alternative_log_evidence - d.nominal_log_evidence,
+                    if d.nominal_check.passed {
+                        "passed"
+                    } else {
+                        "failed"
+                    },
+                    d.practical_shift,
+                    start.elapsed().as_secs_f64()
+                );
+            }
+        }
+    }
+    println!("right verdicts: {right} of {total}");
+    Ok(())
+}
