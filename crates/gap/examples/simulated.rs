@@ -5,7 +5,7 @@
 //! model is right) and hidden effects at the chosen magnitudes, one campaign each.
 //!
 //! `cargo run --release -p chatter-gap --example simulated [-- --machines 0,3
-//! --classes parameter_error,process_damping --magnitudes 1,2 --cuts 24 --poles --seeds 1]`
+//! --classes parameter_error,process_damping --magnitudes 1,2 --cuts 24 --poles --seeds 1 --verbose]`
 
 #![allow(clippy::unwrap_used)]
 
@@ -43,6 +43,7 @@ fn main() -> chatter_gap::Result<()> {
     let cuts: usize = arg("--cuts").and_then(|s| s.parse().ok()).unwrap_or(24);
     let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
     let poles = std::env::args().any(|a| a == "--poles");
+    let verbose = std::env::args().any(|a| a == "--verbose");
     let options = DiagnoseOptions {
         validation: Validation::Off,
         ..DiagnoseOptions::default()
@@ -91,6 +92,30 @@ fn main() -> chatter_gap::Result<()> {
                     },
                     &Quiet,
                 )?;
+                if verbose {
+                    for c in &data.cuts {
+                        eprintln!(
+                            "  cut {:.0} rpm {:.3} mm: {} {:?} ({})",
+                            c.speed_rpm,
+                            c.depth_mm,
+                            if c.stable { "stable" } else { "chatter" },
+                            c.chatter_hz,
+                            c.note.as_deref().unwrap_or("")
+                        );
+                    }
+                    for (p, r) in data.poles.iter().zip(&d.residuals.nominal.poles) {
+                        eprintln!(
+                            "  pole {:.0} rpm {:.3} mm: {:.1} Hz / {:.4}, nominal residual {:+.1} Hz / {:+.4}",
+                            p.speed_rpm,
+                            p.depth_mm,
+                            p.frequency_hz,
+                            p.damping_ratio,
+                            r.frequency_residual_hz,
+                            r.damping_residual
+                        );
+                    }
+                    eprintln!("  nominal check {:?}", d.nominal_check);
+                }
                 let expected = effect.expected_verdict(&error);
                 total += 1;
                 right += usize::from(d.verdict.name() == expected);

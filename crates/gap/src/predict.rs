@@ -17,7 +17,11 @@
 //!   noise.
 //! - a **chattering cut**'s frequency is that of the dominant multiplier at the cut's own depth
 //!   (not at the boundary): the principal frequency arg(mu) / (2 pi tau) with its images
-//!   k / tau +- f_mu for milling, the eigenfunction's frequency for turning.
+//!   k / tau +- f_mu for milling; for turning the frequency Im lambda / 2 pi of the unstable
+//!   root nearest the observed one (past the boundary several roots of a chain are unstable,
+//!   and a limit cycle with loss of contact may settle on any of them: on time-domain
+//!   simulations of the proving ground's lathe at |mu| 1.4-1.6 it settled 25-50 Hz from the
+//!   dominant root, on the root that crossed first).
 //! - an identified **pole** at a stable cut: for milling lambda = ln(mu) / tau of the dominant
 //!   multiplier, lifted over the tooth period (principal frequency |Im lambda| / 2 pi, damping
 //!   -Re lambda / |lambda|, as in 002); for turning the physical root (000 Eq. 6): the dominant
@@ -37,7 +41,9 @@ use crate::data::Dataset;
 use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
-use chatter_stability::frequency_domain::{FrequencyDomain, dominant_pole, mode_poles};
+use chatter_stability::frequency_domain::{
+    FrequencyDomain, dominant_pole, mode_poles, unstable_poles,
+};
 use chatter_stability::monodromy::Discretization;
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -123,17 +129,26 @@ pub(crate) fn predict_cut(
     depth_m: f64,
     immersion: Option<f64>,
     u: f64,
-    with_frequency: bool,
+    observed_chatter_hz: Option<f64>,
 ) -> Option<CutPrediction> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
     let tau = model.operation().delay_s(speed_rpm);
     let s = inference_solver(&model);
-    let (mu, chatter_hz) = if with_frequency && !milling(&model) {
-        s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?
-    } else {
-        let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
-        (mu, mu.principal_frequency_hz())
-    };
+    let (mu, chatter_hz) =
+        if let (Some(observed_hz), false) = (observed_chatter_hz, milling(&model)) {
+            let (mu, dominant_hz) = s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?;
+            // the unstable root nearest the observed chatter (module docs)
+            let nearest = unstable_poles(&model, speed_rpm, depth_m)
+                .ok()?
+                .into_iter()
+                .map(|p| p.lambda.im / (2.0 * PI))
+                .chain(std::iter::once(dominant_hz))
+                .min_by(|a, b| (a - observed_hz).abs().total_cmp(&(b - observed_hz).abs()))?;
+            (mu, nearest)
+        } else {
+            let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
+            (mu, mu.principal_frequency_hz())
+        };
     let ln_modulus = mu.modulus().ln();
     ln_modulus.is_finite().then_some(CutPrediction {
         ln_modulus,
@@ -206,7 +221,7 @@ pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
                 c.depth_m,
                 immersion(c.geometry),
                 c.u,
-                c.chatter_hz.is_some(),
+                c.chatter_hz,
             )
         })
         .collect();

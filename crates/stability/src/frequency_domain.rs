@@ -222,13 +222,51 @@ fn continued_poles(
 /// 4000 steps (tests here) and against the semi-discretization at 4x resolution on the gap
 /// proving ground's turning machine (|mu| within 4e-4 from 0.3x to 2x the limiting depth).
 pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<ClosedLoopPole> {
+    grid_roots(model, speed_rpm, width_m)?
+        .into_iter()
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(ClosedLoopPole::new)
+        .ok_or(StabilityError::NoConvergence {
+            solver: "characteristic-equation Newton",
+            detail: format!("no root found at {speed_rpm} rpm, width {width_m} m"),
+        })
+}
+
+/// Every distinct unstable (Re lambda > 0) closed-loop pole that the starts of
+/// [`dominant_pole`] reach, by decreasing real part (empty when the cut is stable). Past the
+/// boundary several roots of a chain can be unstable; a nonlinear limit cycle (loss of contact)
+/// may grow from any of them, not always the most unstable (on the gap proving ground's lathe
+/// at 1.4-1.6 |mu| the simulated chatter settles 25-50 Hz from the dominant root, on the root
+/// that crossed the axis first).
+pub fn unstable_poles(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+) -> Result<Vec<ClosedLoopPole>> {
+    let mut roots: Vec<Complex64> = grid_roots(model, speed_rpm, width_m)?
+        .into_iter()
+        .filter(|r| r.re > 0.0)
+        .collect();
+    roots.sort_by(|a, b| b.re.total_cmp(&a.re));
+    let mut distinct: Vec<Complex64> = Vec::new();
+    for r in roots {
+        if distinct.iter().all(|d| (d - r).norm() > 1e-6 * r.norm()) {
+            distinct.push(r);
+        }
+    }
+    Ok(distinct.into_iter().map(ClosedLoopPole::new).collect())
+}
+
+/// The roots (upper half plane) that Newton reaches from the starts of [`dominant_pole`].
+fn grid_roots(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<Vec<Complex64>> {
     check_condition(speed_rpm, width_m)?;
     let ch = Characteristic::new(model, speed_rpm)?;
     let spacing = 2.0 * PI / ch.tau / 4.0;
     // the real (non-oscillating) root of the slow surface regeneration, which dominates with
     // process damping at low speed: |lambda| ~ 1 / tau
     let real_starts = REAL_STARTS.iter().map(|x| Complex64::new(-x / ch.tau, 0.0));
-    ch.omegas
+    Ok(ch
+        .omegas
         .iter()
         .flat_map(|&w| {
             let k = (0.15 * w / spacing).ceil() as i64;
@@ -237,12 +275,7 @@ pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result
         .chain(real_starts)
         .filter_map(|start| ch.newton(start, width_m, GRID_NEWTON_ITERATIONS))
         .filter(|root| root.im >= 0.0)
-        .max_by(|a, b| a.re.total_cmp(&b.re))
-        .map(ClosedLoopPole::new)
-        .ok_or(StabilityError::NoConvergence {
-            solver: "characteristic-equation Newton",
-            detail: format!("no root found at {speed_rpm} rpm, width {width_m} m"),
-        })
+        .collect())
 }
 
 /// Each mode's own closed-loop pole, continued in the width from its structural pole as
