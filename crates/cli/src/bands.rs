@@ -4,6 +4,7 @@
 use crate::commands::{Method, compute_lobes, markers};
 use crate::output::{self, emit, write_atomic};
 use crate::plot::{Series, line_chart_svg};
+use crate::report::jobs;
 use crate::validate;
 use crate::{inputs, progress::Bar};
 use anyhow::{Result, bail};
@@ -226,7 +227,8 @@ fn geometric(
     }
     let mut figures = vec![(title.to_string(), svg)];
     figures.extend(extra);
-    finish(req, model, obs, &csv, "lower offset boundary", figures, Vec::new())
+    let label = ("lower offset boundary", jobs::GEOMETRIC_MISSING);
+    finish(req, model, obs, &csv, label, figures, Vec::new())
 }
 
 /// The band plot (depth against speed, with the observed cuts).
@@ -246,7 +248,7 @@ fn finish(
     model: &ModalModel,
     obs: Option<&Observations>,
     csv: &str,
-    lower_label: &str,
+    (lower_label, why_missing): (&str, &str),
     figures: Vec<(String, String)>,
     warnings: Vec<String>,
 ) -> Result<()> {
@@ -254,9 +256,10 @@ fn finish(
         write_atomic(path, svg.as_bytes())?;
     }
     if let Some(path) = req.report {
-        crate::report::jobs::bands(&crate::report::jobs::BandsResult {
+        jobs::bands(&jobs::BandsResult {
             kind: &kind_name(req.kind),
             lower_label,
+            why_missing,
             model,
             observations: obs,
             csv,
@@ -427,7 +430,7 @@ fn perturbation(
         model,
         obs,
         &csv,
-        "lower credibility bound",
+        ("lower credibility bound", jobs::PERTURBATION_MISSING),
         vec![(title, svg)],
         Vec::new(),
     )
@@ -595,7 +598,7 @@ fn montecarlo(
             model,
             obs,
             &csv,
-            "P_s = 0.95 contour",
+            ("P_s = 0.95 contour", jobs::MONTECARLO_MISSING),
             vec![(title.into(), svg)],
             warnings,
         )?;

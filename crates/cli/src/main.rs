@@ -499,10 +499,13 @@ fn message(e: &anyhow::Error) -> String {
 
 fn main() {
     use clap::FromArgMatches;
-    let matches = command().get_matches();
+    let cli = command();
+    let matches = cli.clone().get_matches();
     if let Some((name, sub)) = matches.subcommand() {
         validate::remember_typed(sub);
-        report::remember_invocation(name, sub);
+        if let Some(command) = cli.find_subcommand(name) {
+            report::remember_invocation(command, sub);
+        }
     }
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     if let Err(e) = run(cli) {

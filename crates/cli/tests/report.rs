@@ -73,7 +73,7 @@ fn bands_and_plan_pages_render_with_their_figures() {
             "rpm",
             " mm",
             "N/mm^2",
-            "--offset-rpm",
+            "--speeds",
             "Hz",
         ],
     );

@@ -242,9 +242,16 @@ fn extremes(xs: &[f64], ys: &[f64]) -> Option<((f64, f64), (f64, f64))> {
 }
 
 /// What a band (or lobe) CSV says: its verdict, a summary table and the rows without a
-/// boundary. `csv` has `speed_rpm` and `depth_mm` (the boundary) and may have `lower_mm` (the
-/// conservative curve, called `lower_label`) and `upper_mm`.
-pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str) {
+/// boundary (a warning that gives `why_missing`). `csv` has `speed_rpm` and `depth_mm` (the
+/// boundary) and may have `lower_mm` (the conservative curve, called `lower_label`) and
+/// `upper_mm`.
+pub fn band_findings(
+    page: &mut Page,
+    what: &str,
+    csv: &str,
+    lower_label: &str,
+    why_missing: &str,
+) {
     let c = columns(csv);
     let empty = Vec::new();
     let speeds = c.get("speed_rpm").unwrap_or(&empty);
@@ -277,8 +284,7 @@ pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str) 
         ]);
         if finite < ys.len() {
             page.warning(format!(
-                "{what}, {label}: {} of {} speeds have no boundary (no lobe there, or the \
-                 contour is not reached on the depth grid: a clipped grid; widen --depths)",
+                "{what}, {label}: {} of {} speeds have no boundary ({why_missing})",
                 ys.len() - finite,
                 ys.len()
             ));
@@ -328,12 +334,26 @@ pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str) 
     page.table(table);
 }
 
+/// Why a lobe diagram has no boundary at a speed.
+pub const LOBES_MISSING: &str = "no lobe there: every depth is stable at that speed";
+/// Why a perturbation band has no boundary at a speed.
+pub const PERTURBATION_MISSING: &str =
+    "the contour is not reached on the depth grid: a clipped grid; widen --depths";
+/// Why a Type B offset band has no boundary at a speed.
+pub const GEOMETRIC_MISSING: &str =
+    "the offset boundary does not reach that speed: the ends of the speed range, or no lobe";
+/// Why a Monte Carlo band has no boundary at a speed.
+pub const MONTECARLO_MISSING: &str =
+    "the quantile is not finite there: samples failed or had no lobe at that speed";
+
 /// What `chatter bands` computed, for its page.
 pub struct BandsResult<'a> {
     /// The band kind as typed (`geometric`, `perturbation`, `montecarlo`).
     pub kind: &'a str,
     /// The name of the conservative curve (`lower_mm`).
     pub lower_label: &'a str,
+    /// Why a speed may have no boundary with this kind.
+    pub why_missing: &'a str,
     /// The model.
     pub model: &'a ModalModel,
     /// The observed cuts, when given.
@@ -356,7 +376,7 @@ pub fn bands(r: &BandsResult) -> Result<Page> {
     for w in &r.warnings {
         page.warning(w.clone());
     }
-    band_findings(&mut page, "Bands", r.csv, r.lower_label);
+    band_findings(&mut page, "Bands", r.csv, r.lower_label, r.why_missing);
     page.table(Table::from_csv("Every speed (the CSV)", r.csv));
     for (caption, svg) in &r.figures {
         page.figure(caption, svg)?;
@@ -760,18 +780,21 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
         "Turning tool of 000 (FDM lobes)",
         &text("turning_lobes.csv"),
         "",
+        LOBES_MISSING,
     );
     band_findings(
         &mut page,
         "Turning tool of 000 after updating (Eq. 34)",
         &text("turning_credibility.csv"),
         "lower credibility bound",
+        PERTURBATION_MISSING,
     );
     band_findings(
         &mut page,
         "Milling example of 001 (Type B offsets 100 rpm, 0.2 mm)",
         &text("milling_bands.csv"),
         "lower offset boundary",
+        GEOMETRIC_MISSING,
     );
     diagnosis_findings(&mut page, d);
     for (name, caption) in [
@@ -806,7 +829,7 @@ mod tests {
         let csv = "speed_rpm,depth_mm,lower_mm,upper_mm\n\
                    1000,1,0.5,1.5\n2000,3,2,\n3000,2,1.5,2.5\n";
         let mut page = Page::new("t");
-        band_findings(&mut page, "Bands", csv, "lower bound");
+        band_findings(&mut page, "Bands", csv, "lower bound", "why");
         let html = page.html();
         assert!(
             html.contains("the deepest stable pocket reaches 3 mm at 2000 rpm"),
@@ -821,7 +844,13 @@ mod tests {
     #[test]
     fn a_csv_without_a_finite_boundary_says_so() {
         let mut page = Page::new("t");
-        band_findings(&mut page, "Lobes", "speed_rpm,depth_mm\n1000,inf\n", "");
+        band_findings(
+            &mut page,
+            "Lobes",
+            "speed_rpm,depth_mm\n1000,inf\n",
+            "",
+            LOBES_MISSING,
+        );
         let html = page.html();
         assert!(html.contains("no finite limiting depth"), "{html}");
         assert!(html.contains("1 of 1 speeds have no boundary"), "{html}");

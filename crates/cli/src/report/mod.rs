@@ -355,12 +355,19 @@ figcaption{color:#333;font-size:.9rem}";
 /// Options of this run, remembered by [`remember_invocation`].
 static INVOCATION: OnceLock<Vec<(String, String)>> = OnceLock::new();
 
-/// Remember the options of the subcommand (as typed, and the defaults it used) for the report
-/// page's inputs. Called once by `main`.
-pub fn remember_invocation(name: &str, matches: &clap::ArgMatches) {
-    let mut options = vec![("command".to_string(), format!("chatter {name}"))];
+/// Remember the options of the subcommand `command` (as typed, and the defaults it used) for
+/// the report page's inputs. Called once by `main`.
+pub fn remember_invocation(command: &clap::Command, matches: &clap::ArgMatches) {
+    let mut options = vec![(
+        "command".to_string(),
+        format!("chatter {}", command.get_name()),
+    )];
     for id in matches.ids() {
         let id = id.as_str();
+        // argument groups (one per flattened struct) are not options
+        if id == "quiet" || !command.get_arguments().any(|a| a.get_id() == id) {
+            continue;
+        }
         let Ok(Some(values)) = matches.try_get_raw(id) else {
             continue;
         };
@@ -369,9 +376,6 @@ pub fn remember_invocation(name: &str, matches: &clap::ArgMatches) {
             Some(clap::parser::ValueSource::DefaultValue) => " (default)",
             _ => "",
         };
-        if id == "quiet" {
-            continue;
-        }
         options.push((
             format!("--{}", id.replace('_', "-")),
             format!("{}{source}", values.join(" ")),
