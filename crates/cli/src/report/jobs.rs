@@ -54,7 +54,10 @@ pub fn pileup_warning(p: &chatter_updating::prior_bounds::BoundPileup) -> String
 
 /// Posterior mean and standard deviation per parameter, with units.
 fn posterior_table(caption: &str, names: &[String], mean: &[f64], sd: &[f64]) -> Table {
-    let mut t = Table::new(caption, &["parameter", "mean", "standard deviation", "unit"]);
+    let mut t = Table::new(
+        caption,
+        &["parameter", "mean", "standard deviation", "unit"],
+    );
     for ((name, m), s) in names.iter().zip(mean).zip(sd) {
         t.row(vec![
             name.clone(),
@@ -73,7 +76,11 @@ pub fn update(
     r: &UpdateResult,
     figures: &[(&str, String)],
 ) -> Result<Page> {
-    let mut page = common("chatter update: Bayesian model updating", model, Some(observations));
+    let mut page = common(
+        "chatter update: Bayesian model updating",
+        model,
+        Some(observations),
+    );
     page.model("updated model (posterior mean)", &r.updated_model);
     let best = r
         .classes
@@ -181,8 +188,16 @@ pub fn update(
         let h = &s.held_out;
         for (q, v, u) in [
             ("training points", h.training_points as f64, ""),
-            ("held-out RMS pole frequency error", h.rms_frequency_error_hz, "Hz"),
-            ("held-out max pole frequency error", h.max_frequency_error_hz, "Hz"),
+            (
+                "held-out RMS pole frequency error",
+                h.rms_frequency_error_hz,
+                "Hz",
+            ),
+            (
+                "held-out max pole frequency error",
+                h.max_frequency_error_hz,
+                "Hz",
+            ),
             ("held-out RMS damping-ratio error", h.rms_damping_error, "1"),
             ("held-out max damping-ratio error", h.max_damping_error, "1"),
             (
@@ -202,8 +217,12 @@ pub fn update(
     }
     for (name, svg) in figures {
         let caption = match *name {
-            "evidence.svg" => "Evidence per model class with its two terms, and the class probabilities (000 Fig. 4)",
-            "corner.svg" => "Posterior (blue) over prior draws (grey); diagonal: posterior histogram with its Gaussian fit (000 Fig. 5)",
+            "evidence.svg" => {
+                "Evidence per model class with its two terms, and the class probabilities (000 Fig. 4)"
+            }
+            "corner.svg" => {
+                "Posterior (blue) over prior draws (grey); diagonal: posterior histogram with its Gaussian fit (000 Fig. 5)"
+            }
             other => other,
         };
         page.figure(caption, svg)?;
@@ -245,13 +264,7 @@ fn extremes(xs: &[f64], ys: &[f64]) -> Option<((f64, f64), (f64, f64))> {
 /// boundary (a warning that gives `why_missing`). `csv` has `speed_rpm` and `depth_mm` (the
 /// boundary) and may have `lower_mm` (the conservative curve, called `lower_label`) and
 /// `upper_mm`.
-pub fn band_findings(
-    page: &mut Page,
-    what: &str,
-    csv: &str,
-    lower_label: &str,
-    why_missing: &str,
-) {
+pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str, why_missing: &str) {
     let c = columns(csv);
     let empty = Vec::new();
     let speeds = c.get("speed_rpm").unwrap_or(&empty);
@@ -273,7 +286,8 @@ pub fn band_findings(
     ] {
         let Some(ys) = c.get(column) else { continue };
         let finite = ys.iter().filter(|y| y.is_finite()).count();
-        let (low, high) = extremes(speeds, ys).unwrap_or(((f64::NAN, f64::NAN), (f64::NAN, f64::NAN)));
+        let (low, high) =
+            extremes(speeds, ys).unwrap_or(((f64::NAN, f64::NAN), (f64::NAN, f64::NAN)));
         table.row(vec![
             label.into(),
             format!("{finite} of {}", ys.len()),
@@ -399,6 +413,16 @@ fn effect_words(c: EffectClass) -> &'static str {
     }
 }
 
+/// A region's range with its unit (`3000 to 4317 rpm`, `runs 2 to 21`); empty without one.
+fn region_range(r: &chatter_gap::regions::Region) -> String {
+    use chatter_gap::regions::RegionKind;
+    r.range.map_or(String::new(), |[a, b]| match r.kind {
+        RegionKind::DepthBand => format!("{} to {} mm", number(a), number(b)),
+        RegionKind::Sequence => format!("runs {} to {}", number(a), number(b)),
+        _ => format!("{} to {} rpm", number(a), number(b)),
+    })
+}
+
 /// The verdict, warnings and tables of a diagnosis (shared by `diagnose` and the demo).
 pub fn diagnosis_findings(page: &mut Page, d: &Diagnosis) {
     let best = d.classes.iter().find(|c| c.name == d.best_class);
@@ -432,12 +456,16 @@ pub fn diagnosis_findings(page: &mut Page, d: &Diagnosis) {
         .filter(|r| r.gap_share > 0.0)
         .max_by(|a, b| a.gap_share.total_cmp(&b.gap_share))
     {
-        let range = r.range.map_or(String::new(), |[a, b]| {
-            format!(" ({} to {})", number(a), number(b))
-        });
+        let range = region_range(r);
+        let range = if range.is_empty() {
+            range
+        } else {
+            format!(" ({range})")
+        };
         page.verdict(format!(
-            "The gap lies mostly in {}{range}: {} % of the nominal model's misfit, {} of {} \
-             observations disagreeing. Next test: a cut in that region confirms the diagnosis.",
+            "The largest share of the gap is in the region `{}`{range}: {} % of the nominal \
+             model's misfit, {} of {} observations disagreeing. Next test: a cut in that region \
+             confirms the diagnosis.",
             r.name,
             number(100.0 * r.gap_share),
             r.disagreements,
@@ -552,8 +580,7 @@ pub fn diagnosis_findings(page: &mut Page, d: &Diagnosis) {
     for r in &d.regions {
         t.row(vec![
             r.name.clone(),
-            r.range
-                .map_or(String::new(), |[a, b]| format!("{} to {}", number(a), number(b))),
+            region_range(r),
             r.observations.to_string(),
             r.disagreements.to_string(),
             number(100.0 * r.gap_share),
@@ -567,19 +594,40 @@ pub fn diagnosis_findings(page: &mut Page, d: &Diagnosis) {
             &["metric", "before", "after", "unit"],
         );
         let metrics = [
-            ("balanced misclassification of the cuts", s.balanced_misclassification, "1"),
+            (
+                "balanced misclassification of the cuts",
+                s.balanced_misclassification,
+                "1",
+            ),
             (
                 "log predictive density per observation",
                 Some(s.log_predictive_density_per_observation),
                 "nats",
             ),
-            ("RMS chatter-frequency residual", s.rms_chatter_residual_hz, "Hz"),
-            ("RMS pole-frequency residual", s.rms_pole_frequency_residual_hz, "Hz"),
-            ("RMS pole-damping residual", s.rms_pole_damping_residual, "1"),
+            (
+                "RMS chatter-frequency residual",
+                s.rms_chatter_residual_hz,
+                "Hz",
+            ),
+            (
+                "RMS pole-frequency residual",
+                s.rms_pole_frequency_residual_hz,
+                "Hz",
+            ),
+            (
+                "RMS pole-damping residual",
+                s.rms_pole_damping_residual,
+                "1",
+            ),
         ];
         for (name, m, unit) in metrics {
             if let Some(m) = m {
-                t.row(vec![name.into(), number(m.before), number(m.after), unit.into()]);
+                t.row(vec![
+                    name.into(),
+                    number(m.before),
+                    number(m.after),
+                    unit.into(),
+                ]);
             }
         }
         page.table(t);
@@ -593,7 +641,11 @@ pub fn diagnose(
     d: &Diagnosis,
     figures: &[(String, Vec<u8>)],
 ) -> Result<Page> {
-    let mut page = common("chatter diagnose: sim-to-real gap", model, Some(observations));
+    let mut page = common(
+        "chatter diagnose: sim-to-real gap",
+        model,
+        Some(observations),
+    );
     diagnosis_findings(&mut page, d);
     add_svgs(&mut page, figures, "")?;
     Ok(page)
@@ -713,9 +765,17 @@ pub fn plan(
     }
     let mut t = Table::new("The proposed cut", &["quantity", "value", "unit"]);
     if let Some(n) = &outcome.next_cut {
-        t.row(vec!["spindle speed".into(), number(n.speed_rpm), "rpm".into()]);
+        t.row(vec![
+            "spindle speed".into(),
+            number(n.speed_rpm),
+            "rpm".into(),
+        ]);
         t.row(vec!["depth of cut".into(), number(n.depth_mm), "mm".into()]);
-        t.row(vec!["probability of stability".into(), number(n.p_stable), "1".into()]);
+        t.row(vec![
+            "probability of stability".into(),
+            number(n.p_stable),
+            "1".into(),
+        ]);
         t.row(vec![
             "expected reduction of the sd".into(),
             optional(n.expected_reduction_percent),
@@ -727,7 +787,11 @@ pub fn plan(
             "cm^3/min".into(),
         ]);
     }
-    t.row(vec!["cuts used".into(), outcome.cuts_used.to_string(), "".into()]);
+    t.row(vec![
+        "cuts used".into(),
+        outcome.cuts_used.to_string(),
+        "".into(),
+    ]);
     t.row(vec![
         "effective samples (Kish)".into(),
         number(outcome.effective_samples),
@@ -747,7 +811,10 @@ pub fn plan(
     ));
     match plot {
         Ok(svg) => {
-            page.figure("Cuts made so far (o stable, x chatter) and the proposed cut", &svg)?;
+            page.figure(
+                "Cuts made so far (o stable, x chatter) and the proposed cut",
+                &svg,
+            )?;
         }
         Err(why) => {
             page.warning(format!("no plot of the cuts: {why}"));
@@ -799,7 +866,10 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
     diagnosis_findings(&mut page, d);
     for (name, caption) in [
         ("turning_lobes.csv", "Turning lobes (the CSV)"),
-        ("turning_credibility.csv", "Turning credibility bounds (the CSV)"),
+        (
+            "turning_credibility.csv",
+            "Turning credibility bounds (the CSV)",
+        ),
         ("milling_bands.csv", "Milling Type B bands (the CSV)"),
     ] {
         page.table(Table::from_csv(caption, &text(name)));
@@ -836,8 +906,14 @@ mod tests {
             "{html}"
         );
         assert!(html.contains("below 2 mm stays stable"), "{html}");
-        assert!(html.contains("cuts below 0.5 mm (the lower bound at 1000 rpm)"), "{html}");
-        assert!(html.contains("upper curve: 1 of 3 speeds have no boundary"), "{html}");
+        assert!(
+            html.contains("cuts below 0.5 mm (the lower bound at 1000 rpm)"),
+            "{html}"
+        );
+        assert!(
+            html.contains("upper curve: 1 of 3 speeds have no boundary"),
+            "{html}"
+        );
         assert!(!html.contains("boundary: 1 of 3"), "{html}");
     }
 

@@ -151,12 +151,7 @@ struct Figure {
 
 /// The sections of a page, in order, with their headings.
 pub const SECTIONS: [&str; 6] = [
-    "Verdict",
-    "Warnings",
-    "Inputs",
-    "Model",
-    "Results",
-    "Figures",
+    "Verdict", "Warnings", "Inputs", "Model", "Results", "Figures",
 ];
 
 /// A report page under construction.
@@ -422,7 +417,10 @@ mod tests {
             p.verdict("stable below 2 mm")
                 .warning("w")
                 .input("--model", "m.json")
-                .model("nominal", &chatter_dynamics::examples::schmitz_2023_milling());
+                .model(
+                    "nominal",
+                    &chatter_dynamics::examples::schmitz_2023_milling(),
+                );
             p.table(Table::new("t", &["speed (rpm)"]));
             p.figure("f", SVG).unwrap();
             p
