@@ -253,9 +253,9 @@ impl Page {
             env!("CARGO_PKG_VERSION")
         );
         let section = |out: &mut String, k: usize| {
-            let _ = write!(
+            let _ = writeln!(
                 out,
-                "<section id=\"{}\"><h2>{}</h2>\n",
+                "<section id=\"{}\"><h2>{}</h2>",
                 SECTIONS[k].to_lowercase(),
                 SECTIONS[k]
             );
