@@ -217,18 +217,7 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         );
     }
     for p in &result.prior_bound_pileups {
-        eprintln!(
-            "warning: {}: {:.0} % of the posterior lies at the {} bound {} of its prior (median \
-             {:.4e}): the prior decides this parameter, not the data; widen it with --priors",
-            p.parameter,
-            100.0 * p.share_at_bound,
-            match p.bound {
-                chatter_updating::prior_bounds::Bound::Lower => "lower",
-                chatter_updating::prior_bounds::Bound::Upper => "upper",
-            },
-            p.bound_value,
-            p.posterior_median
-        );
+        eprintln!("warning: {}", crate::report::jobs::pileup_warning(p));
     }
     let prior = job.prior_draws(PRIOR_DRAWS, args.seed);
     let figures = write_outputs(folder, &result, &model, &prior)?;
