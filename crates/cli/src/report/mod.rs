@@ -353,6 +353,12 @@ static INVOCATION: OnceLock<Vec<(String, String)>> = OnceLock::new();
 /// Remember the options of the subcommand `command` (as typed, and the defaults it used) for
 /// the report page's inputs. Called once by `main`.
 pub fn remember_invocation(command: &clap::Command, matches: &clap::ArgMatches) {
+    let _ = INVOCATION.set(options_of(command, matches));
+}
+
+/// The options of a parsed subcommand: `command chatter NAME`, then `--flag value` for every
+/// option given or defaulted (`value (default)`), in the order clap holds them.
+fn options_of(command: &clap::Command, matches: &clap::ArgMatches) -> Vec<(String, String)> {
     let mut options = vec![(
         "command".to_string(),
         format!("chatter {}", command.get_name()),
@@ -376,7 +382,7 @@ pub fn remember_invocation(command: &clap::Command, matches: &clap::ArgMatches) 
             format!("{}{source}", values.join(" ")),
         ));
     }
-    let _ = INVOCATION.set(options);
+    options
 }
 
 /// The remembered options (empty when none were).
@@ -460,6 +466,50 @@ mod tests {
                 .is_err()
         );
         assert!(page.figure("f", "<svg><script>1</script></svg>").is_err());
+    }
+
+    #[test]
+    fn the_inputs_are_the_options_as_typed_with_their_defaults() {
+        let matches = crate::command()
+            .try_get_matches_from([
+                "chatter",
+                "--quiet",
+                "plan",
+                "--model",
+                "m <1>.json",
+                "--observations",
+                "o.json",
+                "--strategy",
+                "mrr",
+                "--report",
+                "r.html",
+            ])
+            .unwrap();
+        let (name, sub) = matches.subcommand().unwrap();
+        let command = crate::command().find_subcommand(name).unwrap().clone();
+        let options = options_of(&command, sub);
+        let get = |flag: &str| {
+            options
+                .iter()
+                .find(|o| o.0 == flag)
+                .map(|o| o.1.as_str())
+                .unwrap_or_else(|| panic!("{flag} missing: {options:?}"))
+        };
+        assert_eq!(get("command"), "chatter plan");
+        assert_eq!(get("--model"), "m <1>.json");
+        assert_eq!(get("--report"), "r.html");
+        assert_eq!(get("--paths"), "300 (default)");
+        assert_eq!(get("--feed-per-tooth-mm"), "0.1 (default)");
+        // neither --quiet nor clap's argument group of the flattened PlanArgs
+        assert!(
+            options
+                .iter()
+                .all(|o| o.0 != "--quiet" && o.0 != "--PlanArgs")
+        );
+        assert!(
+            !options.iter().any(|o| o.0 == "--p-test"),
+            "not given, no default"
+        );
     }
 
     #[test]

@@ -18,13 +18,13 @@ pub struct Rendered {
 
 /// The browser binary, if one is installed.
 fn browser() -> Option<PathBuf> {
-    if let Some(p) = std::env::var_os("CHATTER_CHROMIUM") {
-        return Some(PathBuf::from(p));
+    match std::env::var_os("CHATTER_CHROMIUM") {
+        Some(named) => Some(PathBuf::from(named)).filter(|p| p.exists()),
+        None => ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
+            .iter()
+            .map(PathBuf::from)
+            .find(|p| p.exists()),
     }
-    ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
-        .iter()
-        .map(PathBuf::from)
-        .find(|p| p.exists())
 }
 
 /// Appended before `</body>` of the copy the browser loads (the page itself has no script).
