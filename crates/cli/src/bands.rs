@@ -3,7 +3,8 @@
 
 use crate::commands::{Method, compute_lobes, markers};
 use crate::output::{self, emit, write_atomic};
-use crate::plot::{Series, line_chart, line_chart_svg};
+use crate::plot::{Series, line_chart_svg};
+use crate::report::jobs;
 use crate::validate;
 use crate::{inputs, progress::Bar};
 use anyhow::{Result, bail};
@@ -61,6 +62,8 @@ pub struct BandRequest<'a> {
     pub map_out: Option<&'a Path>,
     /// SVG plot.
     pub plot: Option<&'a Path>,
+    /// HTML report page.
+    pub report: Option<&'a Path>,
     /// No progress bars.
     pub quiet: bool,
 }
@@ -121,9 +124,9 @@ fn check_options(req: &BandRequest) -> Result<()> {
         "the perturbation grid and the Monte Carlo map (--map-out)",
     )?;
     validate::unused(
-        req.observations.is_some() && req.plot.is_none(),
+        req.observations.is_some() && req.plot.is_none() && req.report.is_none(),
         "--observations",
-        "without --plot",
+        "without --plot or --report",
         "drawing the observed cuts on the plot",
     )?;
     if let Some(v) = req.offsets.0 {
@@ -140,7 +143,8 @@ fn check_options(req: &BandRequest) -> Result<()> {
     }
     output::check_optional_file("--out", req.out)?;
     output::check_optional_file("--map-out", req.map_out)?;
-    output::check_optional_file("--plot", req.plot)
+    output::check_optional_file("--plot", req.plot)?;
+    output::check_optional_file("--report", req.report)
 }
 
 /// `chatter bands`.
@@ -197,29 +201,72 @@ fn geometric(
         req.offsets.1.unwrap_or(OFFSET_MM),
     )?;
     let bands = type_b_offsets(&curve, offsets)?;
-    emit(req.out, &geometric_csv(&bands))?;
+    let csv = geometric_csv(&bands);
+    emit(req.out, &csv)?;
+    if req.plot.is_none() && req.report.is_none() {
+        return Ok(());
+    }
+    let series = band_series(
+        curve,
+        bands.lower.clone(),
+        bands.upper.clone(),
+        ["mean boundary", "lower offset", "upper offset"],
+    );
+    let title = "Type B offset boundaries";
+    let svg = band_plot(title, &series, obs)?;
+    let stem = req
+        .plot
+        .and_then(Path::file_stem)
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "bands".into());
+    let extra = theta_distance_svgs(&stem, &bands)?;
     if let Some(path) = req.plot {
-        let series = band_series(
-            curve,
-            bands.lower.clone(),
-            bands.upper.clone(),
-            ["mean boundary", "lower offset", "upper offset"],
-        );
-        line_chart(
-            path,
-            "Type B offset boundaries",
-            "spindle speed (rpm)",
-            "depth (mm)",
-            &series,
-            markers(obs).as_ref(),
-        )?;
-        let stem = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "bands".into());
-        for (name, svg) in theta_distance_svgs(&stem, &bands)? {
+        for (name, svg) in &extra {
             write_atomic(&path.with_file_name(name), svg.as_bytes())?;
         }
+    }
+    let mut figures = vec![(title.to_string(), svg)];
+    figures.extend(extra);
+    let label = ("lower offset boundary", jobs::GEOMETRIC_MISSING);
+    finish(req, model, obs, &csv, label, figures, Vec::new())
+}
+
+/// The band plot (depth against speed, with the observed cuts).
+fn band_plot(title: &str, series: &[Series], obs: Option<&Observations>) -> Result<String> {
+    line_chart_svg(
+        title,
+        "spindle speed (rpm)",
+        "depth (mm)",
+        series,
+        markers(obs).as_ref(),
+    )
+}
+
+/// Write the band plot (the first figure) to `--plot` and the report page to `--report`.
+fn finish(
+    req: &BandRequest,
+    model: &ModalModel,
+    obs: Option<&Observations>,
+    csv: &str,
+    (lower_label, why_missing): (&str, &str),
+    figures: Vec<(String, String)>,
+    warnings: Vec<String>,
+) -> Result<()> {
+    if let (Some(path), Some((_, svg))) = (req.plot, figures.first()) {
+        write_atomic(path, svg.as_bytes())?;
+    }
+    if let Some(path) = req.report {
+        jobs::bands(&jobs::BandsResult {
+            kind: &kind_name(req.kind),
+            lower_label,
+            why_missing,
+            model,
+            observations: obs,
+            csv,
+            figures,
+            warnings,
+        })?
+        .write(path)?;
     }
     Ok(())
 }
@@ -370,20 +417,23 @@ fn perturbation(
     let depths = depth_grid(req, &mean_lobes)?;
     let (csv, series) = credibility_bands(&mean_model, &dist, method, rule, speeds, &depths)?;
     emit(req.out, &csv)?;
-    if let Some(path) = req.plot {
-        line_chart(
-            path,
-            &format!(
-                "Credibility bounds at the posterior mean: {}",
-                rule_title(rule)
-            ),
-            "spindle speed (rpm)",
-            "depth (mm)",
-            &series,
-            markers(obs).as_ref(),
-        )?;
+    if req.plot.is_none() && req.report.is_none() {
+        return Ok(());
     }
-    Ok(())
+    let title = format!(
+        "Credibility bounds at the posterior mean: {}",
+        rule_title(rule)
+    );
+    let svg = band_plot(&title, &series, obs)?;
+    finish(
+        req,
+        model,
+        obs,
+        &csv,
+        ("lower credibility bound", jobs::PERTURBATION_MISSING),
+        vec![(title, svg)],
+        Vec::new(),
+    )
 }
 
 /// Plot title of a bound rule.
@@ -475,6 +525,7 @@ fn montecarlo(
         &|done, _| bar.set(done),
     )?;
     bar.finish();
+    let mut warnings = Vec::new();
     if !sampled.failures.is_empty() {
         // failed samples are left out of P_s and the quantiles, never counted as stable
         let invalid = sampled
@@ -483,14 +534,16 @@ fn montecarlo(
             .filter(|f| f.kind == FailureKind::InvalidSample)
             .count();
         let worst = sampled.failures_per_speed().into_iter().max().unwrap_or(0);
-        eprintln!(
-            "warning: {} sample-speed failures ({} numerical, {invalid} invalid samples), at most \
+        let warning = format!(
+            "{} sample-speed failures ({} numerical, {invalid} invalid samples), at most \
              {worst} of {} samples at one speed, left out of the map; first: {}",
             sampled.failures.len(),
             sampled.failures.len() - invalid,
             thetas.len(),
             sampled.failures[0].message
         );
+        eprintln!("warning: {warning}");
+        warnings.push(warning);
     }
     let depth = sampled.depth_bands();
     let hz = sampled.chatter_frequency_bands();
@@ -524,7 +577,7 @@ fn montecarlo(
         }
         write_atomic(path, text.as_bytes())?;
     }
-    if let Some(path) = req.plot {
+    if req.plot.is_some() || req.report.is_some() {
         let curve = |f: fn(&chatter_uncertainty::montecarlo::QuantileBand) -> f64| {
             depth
                 .iter()
@@ -538,13 +591,16 @@ fn montecarlo(
             curve(|d| d.q95),
             ["P_s = 0.5", "P_s = 0.95", "P_s = 0.05"],
         );
-        line_chart(
-            path,
-            "Monte Carlo probability of stability",
-            "spindle speed (rpm)",
-            "depth (mm)",
-            &series,
-            markers(obs).as_ref(),
+        let title = "Monte Carlo probability of stability";
+        let svg = band_plot(title, &series, obs)?;
+        finish(
+            req,
+            model,
+            obs,
+            &csv,
+            ("P_s = 0.95 contour", jobs::MONTECARLO_MISSING),
+            vec![(title.into(), svg)],
+            warnings,
         )?;
     }
     Ok(())

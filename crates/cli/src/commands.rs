@@ -263,7 +263,7 @@ pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Meth
 }
 
 /// What `--out` of `chatter demo` may hold (the folder of its previous run).
-pub const DEMO_FILES: [&str; 11] = [
+pub const DEMO_FILES: [&str; 12] = [
     "turning_lobes.csv",
     "turning_lobes.svg",
     "eq34_covariance.json",
@@ -275,6 +275,7 @@ pub const DEMO_FILES: [&str; 11] = [
     "shopfloor_observations.json",
     "diagnosis",
     "summary.json",
+    "report.html",
 ];
 
 /// `chatter demo`: the main job on the embedded examples, results into a folder that appears
@@ -414,6 +415,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             validation: crate::diagnose::ValidationArg::Kfold,
             folds: 3,
             out: Some(&folder.path_of("diagnosis")),
+            report: None,
             quiet,
         },
     )?;
@@ -429,6 +431,16 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         }),
     );
 
+    let page = crate::report::jobs::demo(
+        &folder,
+        &[
+            ("turning tool of 000 (Table 1 hammer modes)", &turning),
+            ("milling example of 001", &milling),
+            ("shop-floor machine: the nominal model diagnosed", &nominal),
+        ],
+        &diagnosis,
+    )?;
+    folder.add("report.html", page.html());
     let mut files: Vec<String> = folder
         .paths()
         .iter()

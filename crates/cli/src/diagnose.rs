@@ -32,6 +32,8 @@ pub struct DiagnoseRequest<'a> {
     pub validation: ValidationArg,
     pub folds: usize,
     pub out: Option<&'a Path>,
+    /// HTML report page.
+    pub report: Option<&'a Path>,
     pub quiet: bool,
 }
 
@@ -91,10 +93,16 @@ pub fn run(r: &DiagnoseRequest, folds_given: bool) -> Result<()> {
         .out
         .map(|dir| Folder::new("--out", dir, &FILES))
         .transpose()?;
+    crate::output::check_optional_file("--report", r.report)?;
     if folds_given && r.validation == ValidationArg::Off {
         bail!("--folds is not used with --validation off; it is for kfold and speed-bands");
     }
-    let (_, json, files) = report(r)?;
+    let model = inputs::model(r.model)?;
+    let observations = inputs::observations(r.observations)?;
+    let (diagnosis, json, files) = report_of(&model, &observations, r)?;
+    if let Some(path) = r.report {
+        crate::report::jobs::diagnose(&model, &observations, &diagnosis, &files)?.write(path)?;
+    }
     if let Some(mut folder) = folder {
         for (name, bytes) in files {
             folder.add(name, bytes);
@@ -105,17 +113,10 @@ pub fn run(r: &DiagnoseRequest, folds_given: bool) -> Result<()> {
     writeln!(stdout, "{json}").context("writing to stdout")
 }
 
-/// The diagnosis, its report JSON and, with `out`, the files `diagnosis.json`,
+/// The diagnosis, its report JSON and, with `out` or `report`, the files `diagnosis.json`,
 /// `diagnosed_model.json` (and `diagnosed_effects.json`), `lobes.svg` and `residuals.svg` (name
-/// and content; the caller writes them).
-pub fn report(r: &DiagnoseRequest) -> Result<(Diagnosis, String, Files)> {
-    let model = inputs::model(r.model)?;
-    let observations = inputs::observations(r.observations)?;
-    report_of(&model, &observations, r)
-}
-
-/// [`report`] of a model and observations already read (`r.model` and `r.observations` name
-/// them in messages).
+/// and content; the caller writes them), of a model and observations already read (`r.model`
+/// and `r.observations` name them in messages).
 pub fn report_of(
     model: &chatter_dynamics::ModalModel,
     observations: &chatter_dynamics::Observations,
@@ -199,7 +200,7 @@ pub fn report_of(
         notes: &d.notes,
     };
     let mut files: Files = Vec::new();
-    if r.out.is_some() {
+    if r.out.is_some() || r.report.is_some() {
         let full = serde_json::to_string_pretty(&diagnosis)?;
         files.push(("diagnosis.json".into(), full.into_bytes()));
         files.push((

@@ -15,6 +15,7 @@ mod plan;
 mod plot;
 mod progress;
 mod rcsa;
+mod report;
 mod sensitivity;
 mod update;
 mod validate;
@@ -165,6 +166,9 @@ enum Command {
         /// SVG plot.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// One self-contained HTML page: inputs, plots, numbers, verdict, warnings.
+        #[arg(long)]
+        report: Option<PathBuf>,
     },
     /// Simulate a cut in the time domain; writes a signals CSV or a WAV file.
     Simulate {
@@ -226,6 +230,9 @@ enum Command {
         /// Folder for diagnosis.json (with residuals), lobes.svg and residuals.svg.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// One self-contained HTML page: inputs, plots, numbers, verdict, warnings.
+        #[arg(long)]
+        report: Option<PathBuf>,
     },
     /// Sensitivity |d mu / d theta| of the dominant pole at one cut (000 Table 3) as JSON, on
     /// the one-step map of the full discretization (or the period map).
@@ -355,6 +362,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out,
             map_out,
             plot,
+            report,
         } => bands::bands(&bands::BandRequest {
             model: &model,
             kind,
@@ -371,6 +379,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out: out.as_deref(),
             map_out: map_out.as_deref(),
             plot: plot.as_deref(),
+            report: report.as_deref(),
             quiet,
         }),
         Command::Simulate {
@@ -422,6 +431,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             validation,
             folds,
             out,
+            report,
         } => diagnose::run(
             &diagnose::DiagnoseRequest {
                 model: &model,
@@ -431,6 +441,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 validation,
                 folds: folds.unwrap_or(3),
                 out: out.as_deref(),
+                report: report.as_deref(),
                 quiet,
             },
             folds.is_some(),
@@ -488,9 +499,13 @@ fn message(e: &anyhow::Error) -> String {
 
 fn main() {
     use clap::FromArgMatches;
-    let matches = command().get_matches();
-    if let Some((_, sub)) = matches.subcommand() {
+    let cli = command();
+    let matches = cli.clone().get_matches();
+    if let Some((name, sub)) = matches.subcommand() {
         validate::remember_typed(sub);
+        if let Some(command) = cli.find_subcommand(name) {
+            report::remember_invocation(command, sub);
+        }
     }
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     if let Err(e) = run(cli) {

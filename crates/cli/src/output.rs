@@ -146,6 +146,15 @@ impl Folder {
         self.files.push((relative.into(), bytes.into()));
     }
 
+    /// The bytes added at `relative`, if any (the report page reads the plots back).
+    pub fn get(&self, relative: impl AsRef<Path>) -> Option<&[u8]> {
+        let relative = relative.as_ref();
+        self.files
+            .iter()
+            .find(|(r, _)| r == relative)
+            .map(|(_, bytes)| bytes.as_slice())
+    }
+
     /// The final path of `relative` (for messages).
     pub fn path_of(&self, relative: impl AsRef<Path>) -> PathBuf {
         self.target.join(relative)

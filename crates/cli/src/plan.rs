@@ -62,6 +62,9 @@ pub struct PlanArgs {
     /// Cap on test cuts: `stop` is true once this many cuts were made.
     #[arg(long, default_value_t = chatter_updating::plan::DEFAULT_MAX_TESTS)]
     max_tests: usize,
+    /// One self-contained HTML page: inputs, plots, numbers, next test, warnings.
+    #[arg(long)]
+    report: Option<PathBuf>,
 }
 
 struct PathProgress(Bar);
@@ -75,6 +78,7 @@ impl EnsembleObserver for PathProgress {
 /// Run `chatter plan`: print the next cut as JSON on stdout.
 pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     use crate::validate;
+    crate::output::check_optional_file("--report", args.report.as_deref())?;
     let voi = args.strategy == StrategyArg::Voi;
     validate::unused(
         voi && args.p_test.is_some(),
@@ -166,6 +170,16 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     let mut json = serde_json::to_value(&outcome)?;
     if let Some(map) = json.as_object_mut() {
         map.insert("strategy".into(), strategy.into());
+    }
+    if let Some(path) = &args.report {
+        crate::report::jobs::plan(
+            &model,
+            &observations,
+            &outcome,
+            (!voi).then_some(settings.p_test),
+            crate::report::jobs::plan_plot(&observations, &outcome),
+        )?
+        .write(path)?;
     }
     println!("{}", serde_json::to_string_pretty(&json)?);
     Ok(())

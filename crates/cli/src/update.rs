@@ -62,6 +62,9 @@ pub struct UpdateArgs {
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
+    /// One self-contained HTML page: inputs, plots, numbers, verdict, warnings.
+    #[arg(long)]
+    report: Option<PathBuf>,
 }
 
 /// Likelihood evaluation of milling poles.
@@ -124,6 +127,7 @@ fn parse_classes(spec: &str) -> Result<Vec<f64>> {
 /// Run `chatter update`.
 pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     let folder = Folder::new("--out", &args.out, &FILES)?;
+    crate::output::check_optional_file("--report", args.report.as_deref())?;
     crate::validate::count(
         "--samples",
         args.samples,
@@ -213,32 +217,28 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         );
     }
     for p in &result.prior_bound_pileups {
-        eprintln!(
-            "warning: {}: {:.0} % of the posterior lies at the {} bound {} of its prior (median \
-             {:.4e}): the prior decides this parameter, not the data; widen it with --priors",
-            p.parameter,
-            100.0 * p.share_at_bound,
-            match p.bound {
-                chatter_updating::prior_bounds::Bound::Lower => "lower",
-                chatter_updating::prior_bounds::Bound::Upper => "upper",
-            },
-            p.bound_value,
-            p.posterior_median
-        );
+        eprintln!("warning: {}", crate::report::jobs::pileup_warning(p));
     }
     let prior = job.prior_draws(PRIOR_DRAWS, args.seed);
-    write_outputs(folder, &result, &model, &prior)
+    let figures = write_outputs(folder, &result, &model, &prior)?;
+    match &args.report {
+        Some(path) => {
+            crate::report::jobs::update(&model, &observations, &result, &figures)?.write(path)
+        }
+        None => Ok(()),
+    }
 }
 
 /// Prior draws shown in the corner plot.
 const PRIOR_DRAWS: usize = 2000;
 
+/// Write the result into its folder; returns the plots written (name, SVG) for the report page.
 fn write_outputs(
     mut out: Folder,
     r: &UpdateResult,
     nominal: &chatter_dynamics::ModalModel,
     prior: &[Vec<f64>],
-) -> Result<()> {
+) -> Result<[(&'static str, String); 2]> {
     // posterior.csv: one row per sample, the parameters then the sample weight
     let mut csv = r.parameter_names.join(",") + ",weight\n";
     for (s, w) in r.samples.samples().iter().zip(r.samples.weights()) {
@@ -289,9 +289,15 @@ fn write_outputs(
     );
     let updated = r.updated_model.with_name(Some(name));
     out.add("updated_model.json", updated.to_json_string() + "\n");
-    out.add("evidence.svg", evidence_plot(r)?);
-    out.add("corner.svg", corner_plot(r, prior)?);
-    out.commit().map(drop)
+    let figures = [
+        ("evidence.svg", evidence_plot(r)?),
+        ("corner.svg", corner_plot(r, prior)?),
+    ];
+    for (name, svg) in &figures {
+        out.add(*name, svg.clone());
+    }
+    out.commit()?;
+    Ok(figures)
 }
 
 fn plot_err(e: impl std::fmt::Display) -> anyhow::Error {

@@ -1,6 +1,8 @@
 //! The built `chatter` binary on the example files.
 #![allow(clippy::unwrap_used)]
 
+mod browser;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -166,9 +168,29 @@ fn demo_writes_its_folder() {
         "diagnosis/lobes.svg",
         "diagnosis/residuals.svg",
         "summary.json",
+        "report.html",
     ] {
         assert!(dir.path().join(f).exists(), "{f} missing");
     }
+    // the report page, in a real browser: every plot drawn, the verdicts in words with units
+    let page = dir.path().join("report.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert_eq!(html.matches("<figure>").count(), 7);
+    browser::check(
+        &page,
+        &[
+            "Verdict: process_damping",
+            "process damping that the model leaves out",
+            "the deepest stable pocket reaches",
+            "lower credibility bound",
+            "lower offset boundary",
+            "rpm",
+            " mm",
+            "N/mm^2",
+            "Hz",
+            "ln evidence (nats)",
+        ],
+    );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
             .unwrap();
