@@ -34,7 +34,8 @@
 
 use crate::StabilitySolver;
 use crate::boundary::{
-    BoundaryObserver, BoundaryOptions, LobePoint, boundary_bracket_near, limiting_depth_near,
+    BoundaryObserver, BoundaryOptions, LobePoint, Search, boundary_bracket_near,
+    limiting_depth_near, zero_limit,
 };
 use crate::error::{Result, StabilityError};
 use crate::frequency_domain::FrequencyDomain;
@@ -325,15 +326,15 @@ impl PreparedSolver for PreparedDiscretization {
         let Some(fine) = self.finer(&coarse) else {
             return limiting_depth_near(&solver, &self.model, speed_rpm, guess_m, &self.options);
         };
-        let Some(bracket) =
-            boundary_bracket_near(&solver, &self.model, speed_rpm, guess_m, &self.options)?
-        else {
-            return Ok(LobePoint {
-                speed_rpm,
-                depth_m: f64::INFINITY,
-                chatter_hz: f64::NAN,
-            });
-        };
+        let bracket =
+            match boundary_bracket_near(&solver, &self.model, speed_rpm, guess_m, &self.options)? {
+                Search::Bracket(bracket) => bracket,
+                Search::Unbounded => return Ok(LobePoint::unbounded(speed_rpm)),
+                // zero on either grid: the sign of the first-order shift does not depend on m
+                Search::Zero { probe_m } => {
+                    return zero_limit(&solver, &self.model, speed_rpm, probe_m);
+                }
+            };
         let coarse_depth = bracket.root();
         let slope =
             (bracket.f_positive - bracket.f_negative) / (bracket.positive - bracket.negative);
