@@ -13,8 +13,7 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::{
-    CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
-    Turning,
+    CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation, Turning,
 };
 use chatter_stability::boundary::BoundaryOptions;
 use chatter_stability::prepared::Method;
