@@ -194,7 +194,9 @@ fn geometric(
     speeds: &[f64],
     obs: Option<&Observations>,
 ) -> Result<()> {
-    let lobes = compute_lobes(model, req.method.unwrap_or(Method::Zoa), speeds, req.quiet)?;
+    let method = req.method.unwrap_or(Method::Zoa);
+    let lobes = compute_lobes(model, method, speeds, req.quiet)?;
+    crate::commands::warn_unbounded(&lobes, "they are left out of the bands");
     let curve = finite_curve(&lobes);
     let offsets = TypeBOffsets::new(
         req.offsets.0.unwrap_or(OFFSET_RPM),

@@ -1,9 +1,10 @@
 //! One function per subcommand: parse inputs, call the libraries, write results.
 
+use crate::inputs;
 use crate::output::{self, Folder, emit, write_atomic};
 use crate::plot::{Markers, Series, line_chart, line_chart_svg};
+use crate::progress::{Bar, Working};
 use crate::validate;
-use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::StabilitySolver;
@@ -124,17 +125,19 @@ pub fn compute_lobes(
     quiet: bool,
 ) -> Result<Vec<LobePoint>> {
     match method {
-        // the model's process damping included (003), as the discretizations do; no ceiling
+        // the model's process damping included (003), and the depth ceiling of the
+        // discretizations, 100 mm (a "limit" of 200 m on a very stiff mode is none)
         Method::Zoa => Ok(limiting_depths(
             model,
             speeds,
-            &ZeroOrderOptions::unbounded(),
+            &ZeroOrderOptions::default(),
         )?),
         Method::Fdm | Method::Sdm => {
             if let Some(d) = method.discretization() {
                 validate::work_size(model, d, speeds, "--speeds")?;
             }
             let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
+            bar.announce(&format!("{} speeds, {}", speeds.len(), method.name()));
             let lobes = method
                 .prepare(model, &BoundaryOptions::default())?
                 .lobes(speeds, &bar)?;
@@ -161,12 +164,32 @@ pub fn markers(obs: Option<&Observations>) -> Option<Markers> {
     })
 }
 
+/// The lobes as CSV; a speed without a limit below the depth ceiling has empty depth and
+/// chatter cells (see [`warn_unbounded`]).
 fn lobes_csv(lobes: &[LobePoint]) -> String {
     let mut csv = String::from("speed_rpm,depth_mm,chatter_hz\n");
     for p in lobes {
-        let _ = writeln!(csv, "{},{},{}", p.speed_rpm, p.depth_mm(), p.chatter_hz);
+        if p.depth_m.is_finite() {
+            let _ = writeln!(csv, "{},{},{}", p.speed_rpm, p.depth_mm(), p.chatter_hz);
+        } else {
+            let _ = writeln!(csv, "{},,", p.speed_rpm);
+        }
     }
     csv
+}
+
+/// A warning on stderr with the number of speeds that have no limit, and what became of them
+/// (`fate`, e.g. "their depth_mm and chatter_hz cells are empty").
+pub fn warn_unbounded(lobes: &[LobePoint], fate: &str) {
+    let unbounded = lobes.iter().filter(|p| !p.depth_m.is_finite()).count();
+    if unbounded > 0 {
+        eprintln!(
+            "warning: {unbounded} of {} speeds have no stability limit below the depth ceiling \
+             of {} mm; {fate}",
+            lobes.len(),
+            BoundaryOptions::default().max_depth_m * 1e3
+        );
+    }
 }
 
 /// Read the model and observations, pick the speeds and compute the limiting depths.
@@ -201,11 +224,16 @@ pub fn lobes(
 ) -> Result<()> {
     check_outputs(out, plot, observations)?;
     let (obs, lobes) = load_and_compute(model_path, method, speeds, observations, quiet)?;
+    warn_unbounded(&lobes, "their depth_mm and chatter_hz cells are empty");
     emit(out, &lobes_csv(&lobes))?;
     if let Some(p) = plot {
         let series = [Series {
             label: format!("{method:?} limiting depth").to_lowercase(),
-            points: lobes.iter().map(|l| (l.speed_rpm, l.depth_mm())).collect(),
+            points: lobes
+                .iter()
+                .filter(|l| l.depth_m.is_finite())
+                .map(|l| (l.speed_rpm, l.depth_mm()))
+                .collect(),
             color: BLUE,
             dashed: false,
         }];
@@ -239,13 +267,31 @@ pub fn check_outputs(
 }
 
 /// `chatter multiplier`.
-pub fn multiplier(model_path: &Path, speed_rpm: f64, depth_mm: f64, method: Method) -> Result<()> {
+pub fn multiplier(
+    model_path: &Path,
+    speed_rpm: f64,
+    depth_mm: f64,
+    method: Method,
+    quiet: bool,
+) -> Result<()> {
     let model = inputs::model(model_path)?;
     let Some(solver) = method.discretization() else {
         bail!("--method zoa gives limiting depths, not multipliers; use fdm or sdm");
     };
     validate::work_size(&model, solver, &[speed_rpm], "--speed-rpm")?;
+    let steps = match solver.resolved(&model, speed_rpm)?.steps {
+        chatter_stability::monodromy::StepsPerDelay::Fixed(m) => m.to_string(),
+        chatter_stability::monodromy::StepsPerDelay::Auto => "auto".into(),
+    };
+    let working = Working::start(
+        &format!(
+            "multiplier: {} at {speed_rpm} rpm, {steps} steps per delay",
+            solver.name()
+        ),
+        quiet,
+    );
     let (mu, chatter_hz) = solver.chatter_frequency_hz(&model, speed_rpm, depth_mm * 1e-3)?;
+    working.finish();
     let json = serde_json::json!({
         "speed_rpm": speed_rpm,
         "depth_mm": depth_mm,
@@ -502,6 +548,12 @@ pub fn simulate(
 ) -> Result<()> {
     let model = inputs::model(model_path)?;
     let bar = Bar::new(1000, "simulate", quiet);
+    bar.announce(&format!(
+        "{} s of cutting at {} rpm, {} samples",
+        settings.duration_s,
+        settings.speed_rpm,
+        (settings.duration_s * settings.sample_rate_hz).round()
+    ));
     let sim = chatter_dynamics::simulate::simulate_with_observer(&model, settings, &bar)?;
     bar.finish();
     let is_wav = out

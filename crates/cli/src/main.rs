@@ -344,6 +344,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             )?,
             validate::option("--depth-mm", depth_mm, &chatter_dynamics::limits::DEPTH_MM)?,
             method,
+            quiet,
         ),
         Command::Bands {
             model,

@@ -54,7 +54,8 @@ pub fn lobes(
         model.cutting,
         &model.receptance,
         &speeds,
-        &ZeroOrderOptions::unbounded(),
+        // the depth ceiling of every `lobes` method (see `commands::warn_unbounded`)
+        &ZeroOrderOptions::default(),
     )?))
 }
 

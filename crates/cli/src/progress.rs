@@ -46,6 +46,15 @@ impl Bar {
         }
     }
 
+    /// A first line for logs with the size of the work (`what`, e.g. "2 s at 20000 Hz"), so
+    /// that a log shows the work has started before the first [`LOG_EVERY`] has passed; nothing
+    /// on a terminal (the bar shows it) or when quiet.
+    pub fn announce(&self, what: &str) {
+        if self.log.is_some() {
+            eprintln!("{}: started, {what}", self.message);
+        }
+    }
+
     /// Set the position.
     pub fn set(&self, done: usize) {
         self.bar.set_position(done as u64);
@@ -90,5 +99,55 @@ impl BoundaryObserver for Bar {
 impl chatter_dynamics::simulate::SimulationObserver for Bar {
     fn progress(&self, fraction: f64) {
         self.set((fraction * 1000.0) as usize);
+    }
+}
+
+/// One long computation without steps to count (e.g. the dominant multiplier of a large
+/// operator): a spinner with the elapsed time on a terminal; for logs, a line when it starts
+/// with the size of the work and a line when it ends; nothing when quiet.
+pub struct Working {
+    spinner: Option<ProgressBar>,
+    log: bool,
+    message: String,
+    start: Instant,
+}
+
+impl Working {
+    /// Start: `message` says what runs and how big it is.
+    pub fn start(message: &str, quiet: bool) -> Self {
+        let terminal = std::io::stderr().is_terminal();
+        let spinner = (!quiet && terminal).then(|| {
+            let s = ProgressBar::new_spinner();
+            if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} {elapsed}") {
+                s.set_style(style);
+            }
+            s.set_message(message.to_string());
+            s.enable_steady_tick(Duration::from_millis(200));
+            s
+        });
+        let log = !quiet && !terminal;
+        if log {
+            eprintln!("{message}: started");
+        }
+        Self {
+            spinner,
+            log,
+            message: message.to_string(),
+            start: Instant::now(),
+        }
+    }
+
+    /// Finish: clear the spinner, or a line with the time taken for logs.
+    pub fn finish(self) {
+        if let Some(s) = &self.spinner {
+            s.finish_and_clear();
+        }
+        if self.log {
+            eprintln!(
+                "{}: done in {:.1} s",
+                self.message,
+                self.start.elapsed().as_secs_f64()
+            );
+        }
     }
 }

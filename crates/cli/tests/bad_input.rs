@@ -218,7 +218,7 @@ fn cases(f: &Files) -> Vec<Case> {
         ("0", "operation.teeth"),
         ("-4", "operation.teeth"),
         ("100000", "operation.teeth"),
-        ("2.5", "line 1 column"),
+        ("2.5", "operation.teeth"),
     ] {
         let name = format!("m-teeth-{value}.json");
         let expect = [field, value];
@@ -228,6 +228,21 @@ fn cases(f: &Files) -> Vec<Case> {
             &name,
             &milling("teeth", value),
             &expect,
+        ));
+    }
+    // type errors name the field's path, not only the line and column
+    for (field, value, path) in [
+        ("damping_ratio", r#""0.03""#, "modes[0].damping_ratio"),
+        ("frequency_hz", "true", "modes[0].frequency_hz"),
+        ("radial_immersion", "[0.2]", "operation.radial_immersion"),
+    ] {
+        let name = format!("m-type-{field}.json");
+        c.push(model_case(
+            f,
+            "model type",
+            &name,
+            &milling(field, value),
+            &[path, "invalid type"],
         ));
     }
     for (extra, field, value) in [
@@ -374,6 +389,16 @@ fn cases(f: &Files) -> Vec<Case> {
         &["poles[1]", "repeats poles[0]"],
     ));
     for (name, text, expect) in [
+        (
+            "o-type-stable.json",
+            r#"{"cuts": [{"speed_rpm": 7000, "depth_mm": 1, "stable": "yes"}]}"#,
+            "cuts[0].stable",
+        ),
+        (
+            "o-type-speed.json",
+            r#"{"cuts": [{"speed_rpm": 7000, "depth_mm": 1, "stable": true}, {"speed_rpm": "fast", "depth_mm": 1, "stable": true}]}"#,
+            "cuts[1].speed_rpm",
+        ),
         (
             "o-stable-chatter.json",
             r#"{"cuts": [{"speed_rpm": 7000, "depth_mm": 1, "stable": true, "chatter_hz": 800}]}"#,
@@ -1116,6 +1141,46 @@ fn valid_edge_cases_keep_working() {
             "5000:6000:3",
         ],
         vec!["check", "--model", &undamped],
+        // zero damping: |mu| = 1 at zero depth is marginal, not unstable (limit 0 where any
+        // cut destabilizes the undamped mode)
+        vec![
+            "lobes",
+            "--quiet",
+            "--model",
+            &undamped,
+            "--method",
+            "fdm",
+            "--speeds",
+            "5000:6000:3",
+        ],
+        vec![
+            "lobes",
+            "--quiet",
+            "--model",
+            &undamped,
+            "--method",
+            "sdm",
+            "--speeds",
+            "5000:6000:3",
+        ],
+        vec![
+            "multiplier",
+            "--model",
+            &undamped,
+            "--speed-rpm",
+            "5000",
+            "--depth-mm",
+            "0.5",
+        ],
+        vec![
+            "bands",
+            "--model",
+            &undamped,
+            "--method",
+            "fdm",
+            "--speeds",
+            "5000:6000:3",
+        ],
         vec![
             "lobes",
             "--quiet",
@@ -1138,4 +1203,49 @@ fn valid_edge_cases_keep_working() {
         let (code, err) = run(&args).unwrap();
         assert_eq!(code, Some(0), "{}: {err}", args.join(" "));
     }
+}
+
+/// Speeds without a limit below the 100 mm depth ceiling (both modes 1e12 N/m, so the limits
+/// lie near 200 m) get empty depth and chatter cells, never `inf,NaN`, and a warning that
+/// counts them, for every method; `bands` says it leaves them out.
+#[test]
+fn unbounded_speeds_get_empty_cells_and_a_warning() {
+    let files = Files {
+        dir: tempfile::tempdir().unwrap(),
+    };
+    let model = files.write(
+        "stiff.json",
+        &milling("stiffness_n_per_m", "1e12").replace("3e6", "1e12"),
+    );
+    for method in ["zoa", "fdm", "sdm"] {
+        let out = files.path(&format!("lobes_{method}.csv"));
+        let args = strings(&[
+            "lobes",
+            "--quiet",
+            "--model",
+            &model,
+            "--method",
+            method,
+            "--speeds",
+            "5000:6000:3",
+            "--out",
+            &out,
+        ]);
+        let (code, err) = run(&args).unwrap();
+        assert_eq!(code, Some(0), "{method}: {err}");
+        assert!(
+            err.contains(
+                "warning: 3 of 3 speeds have no stability limit below the depth ceiling of 100 mm"
+            ),
+            "{method}: {err}"
+        );
+        let csv = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(
+            csv, "speed_rpm,depth_mm,chatter_hz\n5000,,\n5500,,\n6000,,\n",
+            "{method}"
+        );
+    }
+    let args = strings(&["bands", "--model", &model, "--speeds", "5000:6000:3"]);
+    let (_, err) = run(&args).unwrap();
+    assert!(err.contains("they are left out of the bands"), "{err}");
 }

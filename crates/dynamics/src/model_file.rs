@@ -549,6 +549,31 @@ pub(crate) fn non_object(text: &str) -> Option<&'static str> {
     }
 }
 
+/// Deserialize the JSON `text` of the file `origin`. A type error names the path of the field
+/// (`operation.teeth: invalid type: floating point `2.5`, expected usize at line 1 column 40`):
+/// serde_json alone gives only the line and column, and derived deserializers cannot know
+/// their own path, so serde_path_to_error (by serde's author, one small dependency-free wrapper
+/// over any serde deserializer) tracks it.
+pub(crate) fn from_json<T: serde::de::DeserializeOwned>(text: &str, origin: &Path) -> Result<T> {
+    let parse_error = |message: String| DynamicsError::Parse {
+        path: origin.to_path_buf(),
+        message,
+    };
+    let mut de = serde_json::Deserializer::from_str(text);
+    let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        if path.is_empty() || path == "." {
+            parse_error(inner.to_string())
+        } else {
+            parse_error(format!("`{path}`: {inner}"))
+        }
+    })?;
+    // trailing characters after the object, as serde_json::from_str checks them
+    de.end().map_err(|e| parse_error(e.to_string()))?;
+    Ok(value)
+}
+
 impl ModalModel {
     /// Parse and validate a model from JSON text; `origin` names the source in errors.
     pub fn from_json_str(text: &str, origin: &Path) -> Result<Self> {
@@ -567,10 +592,7 @@ impl ModalModel {
                 ),
             });
         }
-        let file: ModelFile = serde_json::from_str(text).map_err(|e| DynamicsError::Parse {
-            path: origin.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let file: ModelFile = from_json(text, origin)?;
         file.validate().map_err(|e| e.in_file(origin))
     }
 

@@ -343,11 +343,7 @@ impl Observations {
                 ),
             });
         }
-        let mut obs: Observations =
-            serde_json::from_str(text).map_err(|e| DynamicsError::Parse {
-                path: origin.to_path_buf(),
-                message: e.to_string(),
-            })?;
+        let mut obs: Observations = crate::model_file::from_json(text, origin)?;
         obs.validate().map_err(|e| e.in_file(origin))?;
         let dir = origin.parent().unwrap_or(Path::new(""));
         for s in &mut obs.signals {

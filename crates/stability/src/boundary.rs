@@ -16,6 +16,21 @@ use rayon::prelude::*;
 /// Most Illinois steps refining a bracketed limiting depth.
 const MAX_REFINEMENT_STEPS: usize = 200;
 
+/// |mu| - 1 at zero depth up to which the structure counts as marginally stable rather than
+/// unstable: an undamped mode has |mu| = 1 exactly at b = 0, which the discretizations compute to
+/// round-off. Measured: 2e-12 at 40 steps (the product of m step matrices and the eigenvalue
+/// condition of an undamped pair, ~w_n, in (x, v) coordinates); 1e-8 leaves a factor 100 over the
+/// Krylov–Schur residual tolerance (1e-10) and still tells apart any damping ratio above ~1e-9
+/// (1 - |mu| = 1 - e^{-2 pi zeta f_n tau} with f_n tau >= 1 on the lobes).
+pub const MARGINAL_TOLERANCE: f64 = 1e-8;
+
+/// Factor of the downward scan below the start depth that decides, for a marginally stable
+/// structure unstable at the start depth, whether the limit is zero or a small positive depth.
+const MARGINAL_SCAN_FACTOR: f64 = 10.0;
+/// Depth (fraction of the start depth) below which that scan stops: the structure is unstable
+/// at any depth it can resolve, and the limiting depth is zero.
+const MARGINAL_SCAN_FLOOR: f64 = 1e-6;
+
 /// Options of the boundary search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryOptions {
@@ -69,6 +84,15 @@ pub struct LobePoint {
 }
 
 impl LobePoint {
+    /// The point of a cut stable up to the depth ceiling: infinite depth, no chatter frequency.
+    pub fn unbounded(speed_rpm: f64) -> Self {
+        Self {
+            speed_rpm,
+            depth_m: f64::INFINITY,
+            chatter_hz: f64::NAN,
+        }
+    }
+
     /// Limiting depth in mm.
     pub fn depth_mm(&self) -> f64 {
         self.depth_m * 1e3
@@ -134,31 +158,62 @@ pub fn limiting_depth_near<S: StabilitySolver + ?Sized>(
     guess_m: Option<f64>,
     options: &BoundaryOptions,
 ) -> Result<LobePoint> {
-    let Some(bracket) = boundary_bracket_near(solver, model, speed_rpm, guess_m, options)? else {
-        return Ok(LobePoint {
-            speed_rpm,
-            depth_m: f64::INFINITY,
-            chatter_hz: f64::NAN,
-        });
-    };
-    let depth_m = bracket.root();
-    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
+    match boundary_bracket_near(solver, model, speed_rpm, guess_m, options)? {
+        Search::Unbounded => Ok(LobePoint::unbounded(speed_rpm)),
+        Search::Zero { probe_m } => zero_limit(solver, model, speed_rpm, probe_m),
+        Search::Bracket(bracket) => {
+            let depth_m = bracket.root();
+            let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, depth_m)?;
+            Ok(LobePoint {
+                speed_rpm,
+                depth_m,
+                chatter_hz,
+            })
+        }
+    }
+}
+
+/// A zero limiting depth (a marginally stable structure that any cut destabilizes) with the
+/// chatter frequency of the dominant multiplier at `probe_m`, the smallest depth probed: at zero
+/// depth several undamped modes have |mu| = 1 and the unstable one need not dominate.
+pub(crate) fn zero_limit<S: StabilitySolver + ?Sized>(
+    solver: &S,
+    model: &ModalModel,
+    speed_rpm: f64,
+    probe_m: f64,
+) -> Result<LobePoint> {
+    let (_, chatter_hz) = solver.chatter_frequency_hz(model, speed_rpm, probe_m)?;
     Ok(LobePoint {
         speed_rpm,
-        depth_m,
+        depth_m: 0.0,
         chatter_hz,
     })
 }
 
-/// The search of [`limiting_depth_near`] up to its refined bracket of |mu| - 1 (`None` when
-/// stable up to the ceiling), without the chatter frequency.
+/// What a boundary search found at one speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Search {
+    /// Stable up to the depth ceiling.
+    Unbounded,
+    /// Marginally stable at zero depth (|mu| = 1 within [`MARGINAL_TOLERANCE`]: undamped modes)
+    /// and unstable at every depth resolved, down to `probe_m`: the limiting depth is zero.
+    Zero {
+        /// The smallest depth probed (m), where |mu| >= 1.
+        probe_m: f64,
+    },
+    /// The refined bracket of |mu| - 1.
+    Bracket(Bracket),
+}
+
+/// The search of [`limiting_depth_near`] up to its refined bracket of |mu| - 1, without the
+/// chatter frequency.
 pub(crate) fn boundary_bracket_near<S: StabilitySolver + ?Sized>(
     solver: &S,
     model: &ModalModel,
     speed_rpm: f64,
     guess_m: Option<f64>,
     options: &BoundaryOptions,
-) -> Result<Option<Bracket>> {
+) -> Result<Search> {
     options.validate()?;
     let f = |b: f64| -> Result<f64> {
         Ok(solver.dominant_multiplier(model, speed_rpm, b)?.modulus() - 1.0)
@@ -169,7 +224,7 @@ pub(crate) fn boundary_bracket_near<S: StabilitySolver + ?Sized>(
     let bracket = match guess {
         Some(b) => match widen_from_guess(&f, b, options)? {
             Widened::Bracket(bracket) => Some(bracket),
-            Widened::Unbounded => return Ok(None),
+            Widened::Unbounded => return Ok(Search::Unbounded),
             Widened::BelowStart => None,
         },
         None => None,
@@ -177,11 +232,11 @@ pub(crate) fn boundary_bracket_near<S: StabilitySolver + ?Sized>(
     let bracket = match bracket {
         Some(bracket) => bracket,
         None => match scan_from_start(solver, &f, speed_rpm, options)? {
-            Some(bracket) => bracket,
-            None => return Ok(None),
+            Search::Bracket(bracket) => bracket,
+            other => return Ok(other),
         },
     };
-    illinois(bracket, options.relative_tolerance, MAX_REFINEMENT_STEPS, f).map(Some)
+    illinois(bracket, options.relative_tolerance, MAX_REFINEMENT_STEPS, f).map(Search::Bracket)
 }
 
 /// What widening a bracket from a guess found.
@@ -228,36 +283,74 @@ fn widen_from_guess(
     }
 }
 
-/// The geometric scan from zero depth and `options.start_depth_m` to the first sign change;
-/// `None` when the cut is stable up to the ceiling. Errors when the structure is unstable.
+/// The geometric scan from zero depth and `options.start_depth_m` to the first sign change.
+/// Errors when the structure is unstable at zero depth (|mu| > 1 + [`MARGINAL_TOLERANCE`]).
+/// A marginally stable structure (undamped modes) that is unstable at the start depth is
+/// scanned downwards by [`MARGINAL_SCAN_FACTOR`]: a depth where it is stable brackets a small
+/// limit; where |mu| - 1 stays positive down to the noise level or [`MARGINAL_SCAN_FLOOR`], any
+/// cut destabilizes it (the first-order shift of an undamped pair's root with depth has the
+/// sign of the regenerative term, -b Re[(1 - e^{-i w_n tau}) mu_n / (2 i w_n)]) and the limit is
+/// zero.
 fn scan_from_start<S: StabilitySolver + ?Sized>(
     solver: &S,
     f: &impl Fn(f64) -> Result<f64>,
     speed_rpm: f64,
     options: &BoundaryOptions,
-) -> Result<Option<Bracket>> {
+) -> Result<Search> {
     let mut lo = 0.0;
     let mut g_lo = f(0.0)?;
-    if g_lo >= 0.0 {
+    if g_lo > MARGINAL_TOLERANCE {
         return Err(StabilityError::Unsupported {
             method: solver.name(),
             reason: format!(
-                "|mu| >= 1 at zero depth at {speed_rpm} rpm: the structure is unstable"
+                "|mu| = 1 + {g_lo:.3e} at zero depth at {speed_rpm} rpm: the structure itself is \
+                 unstable (a negative damping ratio?)"
             ),
         });
     }
+    let marginal = g_lo >= -MARGINAL_TOLERANCE;
     let mut hi = options.start_depth_m;
     let mut g_hi = f(hi)?;
+    if marginal && g_hi >= 0.0 {
+        return scan_below_start(f, hi, g_hi, options);
+    }
     while g_hi < 0.0 {
         lo = hi;
         g_lo = g_hi;
         hi *= options.growth;
         if hi > options.max_depth_m {
-            return Ok(None);
+            return Ok(Search::Unbounded);
         }
         g_hi = f(hi)?;
     }
-    Ok(Some(Bracket::new((lo, g_lo), (hi, g_hi))))
+    // a marginal structure: g_lo at zero depth is noise, the start depth is the lower end
+    Ok(Search::Bracket(Bracket::new((lo, g_lo), (hi, g_hi))))
+}
+
+/// The downward scan of [`scan_from_start`] from the start depth `hi` where |mu| - 1 = `g_hi`
+/// >= 0.
+fn scan_below_start(
+    f: &impl Fn(f64) -> Result<f64>,
+    mut hi: f64,
+    mut g_hi: f64,
+    options: &BoundaryOptions,
+) -> Result<Search> {
+    let floor = MARGINAL_SCAN_FLOOR * options.start_depth_m;
+    loop {
+        let lo = hi / MARGINAL_SCAN_FACTOR;
+        if lo < floor {
+            return Ok(Search::Zero { probe_m: hi });
+        }
+        let g_lo = f(lo)?;
+        if g_lo < 0.0 {
+            return Ok(Search::Bracket(Bracket::new((lo, g_lo), (hi, g_hi))));
+        }
+        if g_lo <= MARGINAL_TOLERANCE {
+            // unstable down to the round-off level of |mu| at zero depth
+            return Ok(Search::Zero { probe_m: lo });
+        }
+        (hi, g_hi) = (lo, g_lo);
+    }
 }
 
 /// Limiting depths at many speeds, in parallel; the result does not depend on the thread count.

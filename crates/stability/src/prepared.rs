@@ -34,7 +34,8 @@
 
 use crate::StabilitySolver;
 use crate::boundary::{
-    BoundaryObserver, BoundaryOptions, LobePoint, boundary_bracket_near, limiting_depth_near,
+    BoundaryObserver, BoundaryOptions, LobePoint, Search, boundary_bracket_near,
+    limiting_depth_near, zero_limit,
 };
 use crate::error::{Result, StabilityError};
 use crate::frequency_domain::FrequencyDomain;
@@ -325,18 +326,28 @@ impl PreparedSolver for PreparedDiscretization {
         let Some(fine) = self.finer(&coarse) else {
             return limiting_depth_near(&solver, &self.model, speed_rpm, guess_m, &self.options);
         };
-        let Some(bracket) =
-            boundary_bracket_near(&solver, &self.model, speed_rpm, guess_m, &self.options)?
-        else {
-            return Ok(LobePoint {
-                speed_rpm,
-                depth_m: f64::INFINITY,
-                chatter_hz: f64::NAN,
-            });
-        };
+        let bracket =
+            match boundary_bracket_near(&solver, &self.model, speed_rpm, guess_m, &self.options)? {
+                Search::Bracket(bracket) => bracket,
+                Search::Unbounded => return Ok(LobePoint::unbounded(speed_rpm)),
+                // zero on either grid: the sign of the first-order shift does not depend on m
+                Search::Zero { probe_m } => {
+                    return zero_limit(&solver, &self.model, speed_rpm, probe_m);
+                }
+            };
         let coarse_depth = bracket.root();
         let slope =
             (bracket.f_positive - bracket.f_negative) / (bracket.positive - bracket.negative);
+        // the finer grid's Krylov runs start from the coarse eigenvector on the finer grid
+        let start = solver
+            .start
+            .into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .map(|v| prolonged(&v, self.model.mode_count()));
+        let fine = WarmStarted {
+            discretization: fine,
+            start: Mutex::new(start),
+        };
         let (mu, chatter_hz) = fine.chatter_frequency_hz(&self.model, speed_rpm, coarse_depth)?;
         let g = mu.modulus() - 1.0;
         let mut fine_depth = coarse_depth - g / slope;
@@ -361,12 +372,8 @@ impl PreparedSolver for PreparedDiscretization {
                 chatter_hz,
             }
         } else {
-            let solver = WarmStarted {
-                discretization: fine,
-                start: Mutex::new(None),
-            };
             limiting_depth_near(
-                &solver,
+                &fine,
                 &self.model,
                 speed_rpm,
                 Some(coarse_depth),
@@ -386,6 +393,22 @@ impl PreparedSolver for PreparedDiscretization {
             ..fine_point
         })
     }
+}
+
+/// A start vector of the grid of 2m steps from the state `coarse` on the grid of m steps
+/// (layout [y_0 (2N); delayed q at the M grid points, N each]): y_0 as it is and every delayed
+/// value held over the two finer grid points that halve its step. Only a start of the Krylov
+/// iteration (a close one saves restarts), so the hold needs no better accuracy; where the finer
+/// grid has another dimension (free flight) the start is ignored.
+fn prolonged(coarse: &[f64], modes: usize) -> Vec<f64> {
+    let head = (2 * modes).min(coarse.len());
+    let mut v = Vec::with_capacity(2 * coarse.len());
+    v.extend_from_slice(&coarse[..head]);
+    for q in coarse[head..].chunks(modes.max(1)) {
+        v.extend_from_slice(q);
+        v.extend_from_slice(q);
+    }
+    v
 }
 
 /// A discretization whose Arnoldi runs start from the eigenvector of the previous call: along

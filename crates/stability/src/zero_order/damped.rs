@@ -242,6 +242,10 @@ impl<'a> ProcessDampedTable<'a> {
         for lobe in points.fold_lobes(delay_s, below) {
             insert(&mut lobes, lobe, count, SAME_CROSSING);
         }
+        let slopes: Vec<f64> = self.slopes_per_m.iter().map(|s| s * scale).collect();
+        if let Some(zero) = self.table.system().zero_depth_lobe(delay_s, &slopes) {
+            insert(&mut lobes, zero, count, SAME_CROSSING);
+        }
         Ok(lobes)
     }
 

@@ -11,6 +11,7 @@
 //! Where Re(Lambda) < 0 the eigenvalue is a point of a lobe: the phase
 //! eps = (2 arg(Lambda) - pi) mod 4 pi lies in (0, 2 pi) and the depth is b = -1 / (2 Re(Lambda)).
 
+use super::Lobe;
 use crate::error::{Result, invalid};
 use chatter_dynamics::ModalModel;
 use num_complex::Complex64;
@@ -202,6 +203,84 @@ impl OrientedSystem {
         let half_trace = 0.5 * (m00 + m11);
         let disc = principal_sqrt(half_trace * half_trace - (m00 * m11 - m01 * m10));
         Some(EigenPair([half_trace + disc, half_trace - disc]))
+    }
+}
+
+impl OrientedSystem {
+    /// The lobe at zero depth at delay `delay_s` (s), where undamped modes (zeta_n = 0) are
+    /// destabilized by any cut; `slopes_per_m` are the process-damping slopes d zeta_n / d b
+    /// (empty for none).
+    ///
+    /// At b = 0 an undamped mode has its roots on the imaginary axis, lambda = i w_n, and the
+    /// zero-order characteristic equation has no crossing at finite frequency there (the
+    /// eigenvalue of A_0 G is infinite), so the tabulated branches miss it. Its first-order
+    /// shift with depth (perturbation of the modal equations
+    /// q'' + diag(w_n^2) q = -b Phi^T A_0 Phi (q - q(t - tau)) - 2 b w_n diag(s_n) q') is
+    /// d lambda / d b = eigenvalues of -(1 - e^{-i w_n tau}) / (2 i w_n) Phi^T A_0 Phi - w_n diag(s_n)
+    /// over the undamped modes of one frequency (a cluster of equal frequencies is degenerate and
+    /// is solved together). A positive real part means that any depth destabilizes the cut:
+    /// the limiting depth is 0, with chatter at w_n. For a single mode without process damping
+    /// the condition reads (phi^T A_0 phi) sin(w_n tau) < 0: half of every lobe interval, the
+    /// limit of the lobes' flat bottoms, b_min = 2 zeta (1 + zeta) k / K, as zeta -> 0.
+    pub(crate) fn zero_depth_lobe(&self, delay_s: f64, slopes_per_m: &[f64]) -> Option<Lobe> {
+        let undamped: Vec<usize> = (0..self.modes.len())
+            .filter(|&n| self.modes[n].damping_ratio == 0.0)
+            .collect();
+        let a = &self.directional_n_per_m2;
+        let weight = |m: &ModalTerm, n: &ModalTerm| -> f64 {
+            let [p, q] = m.shape;
+            let [r, t] = n.shape;
+            p * (a[0][0] * r + a[0][1] * t) + q * (a[1][0] * r + a[1][1] * t)
+        };
+        let mut lowest: Option<f64> = None;
+        for (i, &n) in undamped.iter().enumerate() {
+            let wn = self.modes[n].omega_rad_s;
+            // each cluster once, from its first member
+            if undamped[..i]
+                .iter()
+                .any(|&m| self.modes[m].omega_rad_s == wn)
+            {
+                continue;
+            }
+            let cluster: Vec<usize> = undamped[i..]
+                .iter()
+                .copied()
+                .filter(|&m| self.modes[m].omega_rad_s == wn)
+                .collect();
+            let regenerative = (Complex64::new(1.0, 0.0)
+                - Complex64::from_polar(1.0, -wn * delay_s))
+                / Complex64::new(0.0, 2.0 * wn);
+            let k = cluster.len();
+            let shift = nalgebra::DMatrix::<Complex64>::from_fn(k, k, |r, c| {
+                let (mr, mc) = (&self.modes[cluster[r]], &self.modes[cluster[c]]);
+                let damping = if r == c {
+                    wn * slopes_per_m.get(cluster[r]).copied().unwrap_or(0.0)
+                } else {
+                    0.0
+                };
+                -regenerative * weight(mr, mc) - damping
+            });
+            let scale = shift.iter().map(|z| z.norm()).fold(0.0, f64::max);
+            let growth = match k {
+                1 => shift[(0, 0)].re,
+                _ => nalgebra::Schur::new(shift)
+                    .eigenvalues()
+                    .map_or(f64::NEG_INFINITY, |e| {
+                        e.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max)
+                    }),
+            };
+            if growth > ROUNDING * scale {
+                lowest = Some(lowest.map_or(wn, |w: f64| w.min(wn)));
+            }
+        }
+        lowest.map(|wn| {
+            let chatter_hz = wn / (2.0 * PI);
+            Lobe {
+                depth_m: 0.0,
+                chatter_hz,
+                index: (chatter_hz * delay_s).floor() as usize,
+            }
+        })
     }
 }
 

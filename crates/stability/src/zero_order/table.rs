@@ -298,7 +298,11 @@ impl LobeTable {
     /// The `count` lowest lobes at delay `delay_s` (s) with the structural damping, lowest
     /// first (fewer where fewer lobes cross).
     pub fn lobes(&self, delay_s: f64, count: usize) -> Result<Vec<Lobe>> {
-        self.lowest_at(delay_s, count, &Structural(self))
+        let mut lobes = self.lowest_at(delay_s, count, &Structural(self))?;
+        if let Some(zero) = self.system.zero_depth_lobe(delay_s, &[]) {
+            insert(&mut lobes, zero, count, SAME_CROSSING);
+        }
+        Ok(lobes)
     }
 
     /// The `count` lowest lobes of the branch `points` at delay `delay_s` (s).
