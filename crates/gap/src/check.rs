@@ -14,7 +14,7 @@
 //! the number of observable types (Bonferroni).
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, chatter_residual, pole_residuals};
+use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals};
 use crate::predict::Prediction;
 use chatter_bayes::prior::erfc;
 use rand::rngs::StdRng;
@@ -103,7 +103,7 @@ pub(crate) fn predictive_check(
             .filter_map(|(i, c)| {
                 let f = c.chatter_hz?;
                 let q = pred.cuts[i]?;
-                let r = chatter_residual(f, q.chatter_hz, pred.cut_fold_hz[i]);
+                let r = nearest_chatter_residual(f, &q, pred.cut_fold_hz[i]);
                 Some((r / data.chatter_std_hz).powi(2).min(OUTLIER_CAP))
             })
             .collect();

@@ -15,7 +15,7 @@
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::predict::{PredictedPole, Prediction};
+use crate::predict::{CutPrediction, PredictedPole, Prediction};
 use chatter_bayes::prior::erfc;
 use serde::{Deserialize, Serialize};
 
@@ -225,6 +225,15 @@ fn ln_chatter_density(f: f64, predicted: f64, s: f64, fold: Option<f64>) -> f64 
     }
 }
 
+/// The residual of an observed chatter frequency against the nearest frequency `q` admits
+/// ([`CutPrediction::chatter_candidates_hz`]).
+pub(crate) fn nearest_chatter_residual(f: f64, q: &CutPrediction, fold: Option<f64>) -> f64 {
+    q.chatter_candidates_hz()
+        .map(|p| chatter_residual(f, p, fold))
+        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+        .unwrap_or(f64::NAN)
+}
+
 /// The chatter-frequency residual: folded and against the nearer image for milling.
 pub(crate) fn chatter_residual(f: f64, predicted: f64, fold: Option<f64>) -> f64 {
     match fold {
@@ -266,11 +275,14 @@ pub(crate) fn terms(prediction: &Prediction, data: &Dataset, noise: &NoiseModel)
         chatter.push(c.chatter_hz.map(|f| {
             let uniform = -fold.unwrap_or(2.0 * f.max(1.0)).ln();
             match predicted {
-                Some(q) => with_lapse(
-                    ln_chatter_density(f, q.chatter_hz, data.chatter_std_hz, fold),
-                    uniform,
-                    noise.lapse,
-                ),
+                Some(q) => {
+                    let ln: Vec<f64> = q
+                        .chatter_candidates_hz()
+                        .map(|p| ln_chatter_density(f, p, data.chatter_std_hz, fold))
+                        .collect();
+                    let ln_mixture = log_sum_exp(&ln) - (ln.len() as f64).ln();
+                    with_lapse(ln_mixture, uniform, noise.lapse)
+                }
                 None => uniform,
             }
         }));

@@ -17,11 +17,12 @@
 //!   noise.
 //! - a **chattering cut**'s frequency is that of the dominant multiplier at the cut's own depth
 //!   (not at the boundary): the principal frequency arg(mu) / (2 pi tau) with its images
-//!   k / tau +- f_mu for milling; for turning the frequency Im lambda / 2 pi of the unstable
-//!   root nearest the observed one (past the boundary several roots of a chain are unstable,
-//!   and a limit cycle with loss of contact may settle on any of them: on time-domain
-//!   simulations of the proving ground's lathe at |mu| 1.4-1.6 it settled 25-50 Hz from the
-//!   dominant root, on the root that crossed first).
+//!   k / tau +- f_mu for milling; for turning Im lambda / 2 pi of any unstable root, an equal
+//!   mixture over the dominant root and up to three more (past the boundary several roots of a
+//!   chain are unstable, and a limit cycle with loss of contact may settle on any of them: on
+//!   time-domain simulations of the proving ground's lathe at |mu| 1.4-1.6 it settled 25-50 Hz
+//!   from the dominant root, on the root that crossed first; equal weights, so that a machine
+//!   with more unstable roots gains nothing from them on data that follow the dominant one).
 //! - an identified **pole** at a stable cut: for milling lambda = ln(mu) / tau of the dominant
 //!   multiplier, lifted over the tooth period (principal frequency |Im lambda| / 2 pi, damping
 //!   -Re lambda / |lambda|, as in 002); for turning the physical root (000 Eq. 6): the dominant
@@ -55,8 +56,28 @@ pub(crate) struct CutPrediction {
     pub ln_modulus: f64,
     /// ln|mu| without cutting.
     pub ln_modulus_free: f64,
-    /// Predicted chatter frequency (Hz): principal (milling) or physical (turning).
+    /// Predicted chatter frequency (Hz): principal (milling) or physical (turning), of the
+    /// dominant multiplier or root.
     pub chatter_hz: f64,
+    /// For turning, the frequencies (Hz) of the other unstable roots a limit cycle may settle
+    /// on (module docs), by decreasing growth rate; NaN where there are fewer.
+    pub other_chatter_hz: [f64; OTHER_ROOTS],
+}
+
+/// Most unstable roots besides the dominant one that a turning chatter frequency is mixed over.
+pub(crate) const OTHER_ROOTS: usize = 3;
+
+impl CutPrediction {
+    /// The frequencies a chattering cut may show: the dominant one, then the other unstable
+    /// roots'.
+    pub fn chatter_candidates_hz(&self) -> impl Iterator<Item = f64> + '_ {
+        std::iter::once(self.chatter_hz).chain(
+            self.other_chatter_hz
+                .iter()
+                .copied()
+                .filter(|f| f.is_finite()),
+        )
+    }
 }
 
 impl CutPrediction {
@@ -129,31 +150,33 @@ pub(crate) fn predict_cut(
     depth_m: f64,
     immersion: Option<f64>,
     u: f64,
-    observed_chatter_hz: Option<f64>,
+    with_frequency: bool,
 ) -> Option<CutPrediction> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
     let tau = model.operation().delay_s(speed_rpm);
     let s = inference_solver(&model);
-    let (mu, chatter_hz) =
-        if let (Some(observed_hz), false) = (observed_chatter_hz, milling(&model)) {
-            let (mu, dominant_hz) = s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?;
-            // the unstable root nearest the observed chatter (module docs)
-            let nearest = unstable_poles(&model, speed_rpm, depth_m)
-                .ok()?
-                .into_iter()
-                .map(|p| p.lambda.im / (2.0 * PI))
-                .chain(std::iter::once(dominant_hz))
-                .min_by(|a, b| (a - observed_hz).abs().total_cmp(&(b - observed_hz).abs()))?;
-            (mu, nearest)
-        } else {
-            let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
-            (mu, mu.principal_frequency_hz())
-        };
+    let mut other_chatter_hz = [f64::NAN; OTHER_ROOTS];
+    let (mu, chatter_hz) = if with_frequency && !milling(&model) {
+        let (mu, dominant_hz) = s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?;
+        let others = unstable_poles(&model, speed_rpm, depth_m)
+            .ok()?
+            .into_iter()
+            .map(|p| p.lambda.im / (2.0 * PI))
+            .filter(|f| (f - dominant_hz).abs() > 1e-6 * dominant_hz.abs());
+        for (slot, f) in other_chatter_hz.iter_mut().zip(others) {
+            *slot = f;
+        }
+        (mu, dominant_hz)
+    } else {
+        let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
+        (mu, mu.principal_frequency_hz())
+    };
     let ln_modulus = mu.modulus().ln();
     ln_modulus.is_finite().then_some(CutPrediction {
         ln_modulus,
         ln_modulus_free: free_ln_modulus(&model, tau),
         chatter_hz,
+        other_chatter_hz,
     })
 }
 
@@ -221,7 +244,7 @@ pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
                 c.depth_m,
                 immersion(c.geometry),
                 c.u,
-                c.chatter_hz,
+                c.chatter_hz.is_some(),
             )
         })
         .collect();

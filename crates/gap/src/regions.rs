@@ -12,7 +12,7 @@
 //! the total misfit of the nominal model.
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, chatter_residual, pole_residuals};
+use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals};
 use crate::predict::Prediction;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -95,7 +95,7 @@ pub(crate) fn residuals(prediction: &Prediction, data: &Dataset, noise: &NoiseMo
             let observed = if c.stable { 1.0 - p } else { p };
             let label_misfit = -observed.ln() + p.max(1.0 - p).ln();
             let chatter_residual_hz = c.chatter_hz.and_then(|f| {
-                predicted.map(|q| chatter_residual(f, q.chatter_hz, prediction.cut_fold_hz[i]))
+                predicted.map(|q| nearest_chatter_residual(f, &q, prediction.cut_fold_hz[i]))
             });
             let chatter_misfit =
                 chatter_residual_hz.map_or(0.0, |r| 0.5 * (r / data.chatter_std_hz).powi(2));
