@@ -308,7 +308,7 @@ fn bands_geometric<'py>(
 /// `posterior_covariance`, `samples`), a posterior folder of `chatter update` or a covariance
 /// file.
 fn distribution_of(obj: &Bound<'_, PyAny>) -> PyResult<ParameterDistribution> {
-    if let Ok(d) = obj.downcast::<PyDict>() {
+    if let Ok(d) = obj.cast::<PyDict>() {
         let names: Vec<String> = d
             .get_item("parameter_names")?
             .ok_or_else(|| value_error("distribution: `parameter_names` is missing"))?
@@ -799,6 +799,16 @@ fn diagnose<'py>(
     })?
     .map_err(value_error)?;
     let out = to_py(py, &diagnosis)?;
+    let classes = out.get_item("classes")?;
+    for (i, c) in diagnosis.classes.iter().enumerate() {
+        let entry = classes.get_item(i)?;
+        entry.set_item(
+            "posterior_parameter_names",
+            c.posterior.parameter_names.clone(),
+        )?;
+        let width = c.posterior.parameter_names.len();
+        entry.set_item("posterior_samples", matrix(py, &c.posterior.samples, width)?)?;
+    }
     out.set_item(
         "diagnosed_model",
         to_py(py, &ModelFile::from_model(diagnosis.diagnosed_model()))?,
@@ -861,7 +871,7 @@ fn run_campaign<'py>(
     match result {
         (_, Ok(row)) => {
             d.set_item("line", row.csv_line())?;
-            if let Ok(cells) = to_py(py, &row)?.downcast_into::<PyDict>() {
+            if let Ok(cells) = to_py(py, &row)?.cast_into::<PyDict>() {
                 d.update(cells.as_mapping())?;
             }
         }
@@ -900,6 +910,39 @@ fn campaign_table(lines: &Bound<'_, PyList>) -> PyResult<String> {
     Ok(campaign::table(&lines))
 }
 
+/// A synthetic shop-floor campaign of the gap diagnosis's proving ground
+/// (`chatter_gap::synthesize` on `chatter_gap::nominal_milling`): the nominal model and
+/// observations of a machine with `effect` (an effect class name, or "none") at `magnitude`
+/// (1 = the reference size of the class), `cuts` test cuts and poles at `pole_speeds` speeds
+/// (0: none), seeded. Returns `(model, observations)` as dicts.
+#[pyfunction]
+#[pyo3(signature = (effect, magnitude, seed, cuts=32, pole_speeds=4))]
+fn synthetic_campaign<'py>(
+    py: Python<'py>,
+    effect: &str,
+    magnitude: f64,
+    seed: u64,
+    cuts: usize,
+    pole_speeds: usize,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let nominal = chatter_gap::nominal_milling().map_err(value_error)?;
+    let mut scenario = chatter_gap::Scenario::new(chatter_gap::HiddenEffect::ParameterError, seed);
+    let (lo, hi) = scenario.speed_range_rpm;
+    scenario = scenario.with_speed_range(lo, hi, pole_speeds);
+    scenario.cuts = cuts;
+    if effect != "none" {
+        let class: chatter_gap::EffectClass = effect.parse().map_err(value_error)?;
+        (scenario.effect, scenario.error) =
+            chatter_gap::generator::effect_at(class, magnitude, &nominal, scenario.speed_range_rpm)
+                .map_err(value_error)?;
+    }
+    let observations = chatter_gap::synthesize(&nominal, &scenario).map_err(value_error)?;
+    Ok((
+        to_py(py, &ModelFile::from_model(&nominal))?,
+        from_json(py, &observations.to_json_string())?,
+    ))
+}
+
 /// The compiled part of the `chatter` package.
 #[pymodule]
 fn _chatter(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -921,6 +964,7 @@ fn _chatter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_campaign, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(campaign_table, m)?)?;
+    m.add_function(wrap_pyfunction!(synthetic_campaign, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -27,8 +27,10 @@ from ._chatter import (  # noqa: F401
     read_manifest,
     run_campaign,
     simulate,
+    synthetic_campaign,
     update,
     validate,
 )
 from .inference import diagnosis_inference_data, update_inference_data  # noqa: F401
 from .fleet import run_dask  # noqa: F401
+from .synthetic import write_fleet  # noqa: F401
