@@ -807,7 +807,10 @@ fn diagnose<'py>(
             c.posterior.parameter_names.clone(),
         )?;
         let width = c.posterior.parameter_names.len();
-        entry.set_item("posterior_samples", matrix(py, &c.posterior.samples, width)?)?;
+        entry.set_item(
+            "posterior_samples",
+            matrix(py, &c.posterior.samples, width)?,
+        )?;
     }
     out.set_item(
         "diagnosed_model",

@@ -7,7 +7,7 @@ import pytest
 
 import chatter
 
-CAMPAIGNS = int(os.environ.get("CHATTER_FLEET_CAMPAIGNS", "6"))
+CAMPAIGNS = int(os.environ.get("CHATTER_FLEET_CAMPAIGNS", "4"))
 SAMPLES, PATHS = 40, 20
 
 
