@@ -9,11 +9,11 @@ use crate::validate;
 use crate::{inputs, progress::Bar};
 use anyhow::{Result, bail};
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_stability::boundary::{BoundaryOptions, LobePoint};
+use chatter_jobs::bands as band_jobs;
 use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
-use chatter_uncertainty::montecarlo::{FailureKind, sample_boundaries};
+use chatter_uncertainty::montecarlo::FailureKind;
 use chatter_uncertainty::parameters::ParameterDistribution;
-use chatter_uncertainty::perturbation::{BoundRule, model_moment_grid};
+use chatter_uncertainty::perturbation::BoundRule;
 use plotters::style::{BLUE, GREEN, RGBColor};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -180,24 +180,15 @@ pub fn bands(req: &BandRequest) -> Result<()> {
     }
 }
 
-fn finite_curve(lobes: &[LobePoint]) -> Vec<(f64, f64)> {
-    lobes
-        .iter()
-        .filter(|p| p.depth_m.is_finite())
-        .map(|p| (p.speed_rpm, p.depth_mm()))
-        .collect()
-}
-
 fn geometric(
     req: &BandRequest,
     model: &ModalModel,
     speeds: &[f64],
     obs: Option<&Observations>,
 ) -> Result<()> {
-    let method = req.method.unwrap_or(Method::Zoa);
-    let lobes = compute_lobes(model, method, speeds, req.quiet)?;
+    let lobes = compute_lobes(model, req.method.unwrap_or(Method::Zoa), speeds, req.quiet)?;
     crate::commands::warn_unbounded(&lobes, "they are left out of the bands");
-    let curve = finite_curve(&lobes);
+    let curve = band_jobs::finite_curve(&lobes);
     let offsets = TypeBOffsets::new(
         req.offsets.0.unwrap_or(OFFSET_RPM),
         req.offsets.1.unwrap_or(OFFSET_MM),
@@ -379,27 +370,20 @@ fn distribution(req: &BandRequest, model: &ModalModel) -> Result<ParameterDistri
     })
 }
 
-fn discretization(req: &BandRequest) -> Result<chatter_stability::monodromy::Discretization> {
-    match req.method.unwrap_or(Method::Fdm).discretization() {
-        Some(d) => Ok(d),
-        None => bail!("--kind {} needs --method fdm or sdm", kind_name(req.kind)),
+/// The method of a band kind that needs a discretization.
+fn discretized_method(req: &BandRequest) -> Result<Method> {
+    let method = req.method.unwrap_or(Method::Fdm);
+    if method.discretization().is_none() {
+        bail!("--kind {} needs --method fdm or sdm", kind_name(req.kind));
     }
+    Ok(method)
 }
 
-/// Depth grid: `--depths` or 0 to 1.5 times the deepest finite limit, 100 points.
-fn depth_grid(req: &BandRequest, reference: &[LobePoint]) -> Result<Vec<f64>> {
-    if let Some(spec) = req.depths {
-        return validate::grid("--depths", spec, &validate::DEPTH_GRID_MM);
-    }
-    let top = reference
-        .iter()
-        .map(|p| p.depth_mm())
-        .filter(|d| d.is_finite())
-        .fold(0.0, f64::max);
-    if top <= 0.0 {
-        bail!("no finite limiting depth over these speeds; give --depths MIN:MAX:N");
-    }
-    Ok((1..=100).map(|j| 1.5 * top * j as f64 / 100.0).collect())
+/// `--depths` when given.
+fn depth_option(req: &BandRequest) -> Result<Option<Vec<f64>>> {
+    req.depths
+        .map(|spec| validate::grid("--depths", spec, &validate::DEPTH_GRID_MM))
+        .transpose()
 }
 
 fn perturbation(
@@ -413,11 +397,10 @@ fn perturbation(
         None => BoundRule::ComplexSd,
     };
     let dist = distribution(req, model)?;
-    let method = discretization(req)?;
-    let mean_model = dist.mean_model(model)?;
-    let mean_lobes = compute_lobes(&mean_model, req.method.unwrap_or(Method::Fdm), speeds, true)?;
-    let depths = depth_grid(req, &mean_lobes)?;
-    let (csv, series) = credibility_bands(&mean_model, &dist, method, rule, speeds, &depths)?;
+    let method = discretized_method(req)?;
+    let bands = band_jobs::perturbation(model, &dist, method, rule, speeds, depth_option(req)?)
+        .map_err(crate::job_error)?;
+    let (csv, series) = credibility_bands(&bands.bounds, rule);
     emit(req.out, &csv)?;
     if req.plot.is_none() && req.report.is_none() {
         return Ok(());
@@ -446,29 +429,15 @@ pub fn rule_title(rule: BoundRule) -> String {
     }
 }
 
-/// Credibility bounds of the model at the distribution's mean (000 Eq. 14-18 with the covariance
-/// about the mean) on a speed x depth grid under `rule`: CSV
+/// Credibility bounds (000 Eq. 14-18, [`band_jobs::perturbation`]) under `rule` as CSV
 /// `speed_rpm,depth_mm,lower_mm,upper_mm` (empty cells where a contour is not reached on the
 /// grid) and the plot series, broken (NaN) at those speeds so no line is drawn across a gap.
 pub fn credibility_bands(
-    mean_model: &ModalModel,
-    dist: &ParameterDistribution,
-    method: chatter_stability::monodromy::Discretization,
+    bounds: &[chatter_uncertainty::perturbation::CredibilityPoint],
     rule: BoundRule,
-    speeds: &[f64],
-    depths: &[f64],
-) -> Result<(String, [Series; 3])> {
-    let grid = model_moment_grid(
-        method,
-        mean_model,
-        &dist.modal_parameters()?,
-        &dist.covariance_about_mean(),
-        speeds,
-        depths,
-    )?;
-    let bounds = grid.bounds(rule);
+) -> (String, [Series; 3]) {
     let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm\n");
-    for b in &bounds {
+    for b in bounds {
         let _ = writeln!(
             csv,
             "{},{},{},{}",
@@ -505,7 +474,7 @@ pub fn credibility_bands(
         pick(|b| b.upper_mm),
         [&mean, &lower, &upper],
     );
-    Ok((csv, series))
+    (csv, series)
 }
 
 fn montecarlo(
@@ -515,19 +484,22 @@ fn montecarlo(
     obs: Option<&Observations>,
 ) -> Result<()> {
     let dist = distribution(req, model)?;
-    let method = discretization(req)?;
-    let thetas = dist.draws(req.samples.unwrap_or(SAMPLES), req.seed.unwrap_or(0))?;
-    let bar = Bar::new(thetas.len() as u64, "Monte Carlo samples", req.quiet);
-    let sampled = sample_boundaries(
-        &method,
-        &dist.parameterization(model)?,
-        &thetas,
+    let method = discretized_method(req)?;
+    let samples = req.samples.unwrap_or(SAMPLES);
+    let bar = Bar::new(samples as u64, "Monte Carlo samples", req.quiet);
+    let mc = band_jobs::montecarlo(
+        model,
+        &dist,
+        method,
+        samples,
+        req.seed.unwrap_or(0),
         speeds,
-        &BoundaryOptions::default(),
         &|done, _| bar.set(done),
-    )?;
+    )
+    .map_err(crate::job_error)?;
     bar.finish();
     let mut warnings = Vec::new();
+    let sampled = &mc.sampled;
     if !sampled.failures.is_empty() {
         // failed samples are left out of P_s and the quantiles, never counted as stable
         let invalid = sampled
@@ -541,18 +513,17 @@ fn montecarlo(
              {worst} of {} samples at one speed, left out of the map; first: {}",
             sampled.failures.len(),
             sampled.failures.len() - invalid,
-            thetas.len(),
+            mc.draws,
             sampled.failures[0].message
         );
         eprintln!("warning: {warning}");
         warnings.push(warning);
     }
-    let depth = sampled.depth_bands();
-    let hz = sampled.chatter_frequency_bands();
+    let (depth, hz) = (&mc.depth, &mc.chatter_hz);
     let mut csv = String::from(
         "speed_rpm,depth_mm,lower_mm,upper_mm,chatter_hz_q05,chatter_hz_q50,chatter_hz_q95\n",
     );
-    for (d, f) in depth.iter().zip(&hz) {
+    for (d, f) in depth.iter().zip(hz) {
         let _ = writeln!(
             csv,
             "{},{},{},{},{},{},{}",
@@ -561,16 +532,7 @@ fn montecarlo(
     }
     emit(req.out, &csv)?;
     if let Some(path) = req.map_out {
-        let reference: Vec<LobePoint> = depth
-            .iter()
-            .map(|d| LobePoint {
-                speed_rpm: d.speed_rpm,
-                depth_m: d.q95 * 1e-3,
-                chatter_hz: f64::NAN,
-            })
-            .collect();
-        let depths = depth_grid(req, &reference)?;
-        let map = sampled.stability_map(&depths);
+        let map = mc.map(depth_option(req)?).map_err(crate::job_error)?;
         let mut text = String::from("speed_rpm,depth_mm,p_stable\n");
         for (s, row) in map.speeds_rpm.iter().zip(&map.p_stable) {
             for (b, p) in map.depths_mm.iter().zip(row) {

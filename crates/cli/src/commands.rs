@@ -10,7 +10,7 @@ use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 pub use chatter_stability::prepared::Method;
-use chatter_stability::zero_order::{ZeroOrderOptions, limiting_depths, zoa_lobes};
+use chatter_stability::zero_order::zoa_lobes;
 use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
 use plotters::style::BLUE;
 use std::fmt::Write as _;
@@ -124,27 +124,16 @@ pub fn compute_lobes(
     speeds: &[f64],
     quiet: bool,
 ) -> Result<Vec<LobePoint>> {
-    match method {
-        // the model's process damping included (003), and the depth ceiling of the
-        // discretizations, 100 mm (a "limit" of 200 m on a very stiff mode is none)
-        Method::Zoa => Ok(limiting_depths(
-            model,
-            speeds,
-            &ZeroOrderOptions::default(),
-        )?),
-        Method::Fdm | Method::Sdm => {
-            if let Some(d) = method.discretization() {
-                validate::work_size(model, d, speeds, "--speeds")?;
-            }
-            let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
-            bar.announce(&format!("{} speeds, {}", speeds.len(), method.name()));
-            let lobes = method
-                .prepare(model, &BoundaryOptions::default())?
-                .lobes(speeds, &bar)?;
-            bar.finish();
-            Ok(lobes)
-        }
+    if let Some(d) = method.discretization() {
+        validate::work_size(model, d, speeds, "--speeds")?;
     }
+    // zero-order lobes are instant: no bar
+    let bar = Bar::new(speeds.len() as u64, "lobes", quiet || method == Method::Zoa);
+    bar.announce(&format!("{} speeds, {}", speeds.len(), method.name()));
+    let lobes =
+        chatter_jobs::bands::lobes(model, method, speeds, &bar).map_err(crate::job_error)?;
+    bar.finish();
+    Ok(lobes)
 }
 
 pub fn markers(obs: Option<&Observations>) -> Option<Markers> {
@@ -377,14 +366,17 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     let coarse: Vec<f64> = (0..=36).map(|i| 6800.0 + 25.0 * i as f64).collect();
     let updated_lobes = compute_lobes(&updated, Method::Fdm, &coarse, quiet)?;
     let depths = lobe_covering_depths(&updated_lobes)?;
-    let (csv, series) = crate::bands::credibility_bands(
-        &updated,
+    let rule = chatter_uncertainty::perturbation::BoundRule::ComplexSd;
+    let bands = chatter_jobs::bands::perturbation(
+        &turning,
         &dist,
-        chatter_stability::monodromy::Discretization::full(),
-        chatter_uncertainty::perturbation::BoundRule::ComplexSd,
+        Method::Fdm,
+        rule,
         &coarse,
-        &depths,
-    )?;
+        Some(depths),
+    )
+    .map_err(crate::job_error)?;
+    let (csv, series) = crate::bands::credibility_bands(&bands.bounds, rule);
     folder.add("turning_credibility.csv", csv);
     folder.add(
         "turning_credibility.svg",

@@ -4,9 +4,8 @@ use crate::output::Folder;
 use crate::plot::{Markers, Series, line_chart_svg};
 use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
-use chatter_gap::{
-    DiagnoseOptions, Diagnosis, DiagnosisObserver, EffectClass, Validation, diagnose,
-};
+use chatter_gap::{Diagnosis, DiagnosisObserver, EffectClass, Validation};
+use chatter_jobs::diagnose::{DiagnoseRequest as JobRequest, diagnose};
 use plotters::style::{BLUE, RED};
 use std::io::Write;
 use std::path::Path;
@@ -124,45 +123,17 @@ pub fn report_of(
 ) -> Result<(Diagnosis, String, Files)> {
     crate::validate::observations_match(model, observations, r.observations, r.model)?;
     crate::validate::observation_work_size(model, observations, r.observations)?;
-    // k-fold splits the entries, speed bands split the distinct speeds
-    let (available, what) = match r.validation {
-        ValidationArg::Kfold => (
-            observations.cuts.len() + observations.poles.len(),
-            "cuts and poles",
-        ),
-        ValidationArg::SpeedBands => {
-            let mut distinct = observations.speeds_rpm();
-            distinct.sort_by(f64::total_cmp);
-            distinct.dedup();
-            (distinct.len(), "distinct speeds")
-        }
-        ValidationArg::Off => (usize::MAX, ""),
-    };
-    if available > 0 && r.folds > available {
-        bail!(
-            "--folds {}: {} holds {available} {what}; expected at most one fold per entry",
-            r.folds,
-            r.observations.display()
-        );
-    }
-    crate::validate::count(
-        "--samples",
-        r.samples,
-        40,
-        100_000,
-        "samples per model class",
-    )?;
     let validation = match r.validation {
         ValidationArg::Kfold => Validation::KFold { folds: r.folds },
         ValidationArg::SpeedBands => Validation::SpeedBands { bands: r.folds },
         ValidationArg::Off => Validation::Off,
     };
-    let options = DiagnoseOptions {
+    let request = JobRequest {
         seed: r.seed,
         samples: r.samples,
         validation,
-        ..DiagnoseOptions::default()
     };
+    chatter_jobs::diagnose::check(observations, &request).map_err(crate::job_error)?;
     let folds = if validation == Validation::Off {
         0
     } else {
@@ -176,13 +147,15 @@ pub fn report_of(
         ),
         done: AtomicUsize::new(0),
     };
-    let diagnosis = diagnose(model, observations, &options, &progress).with_context(|| {
-        format!(
-            "diagnosing {} against {}",
-            r.observations.display(),
-            r.model.display()
-        )
-    })?;
+    let diagnosis = diagnose(model, observations, &request, &progress)
+        .map_err(crate::job_error)
+        .with_context(|| {
+            format!(
+                "diagnosing {} against {}",
+                r.observations.display(),
+                r.model.display()
+            )
+        })?;
     progress.bar.finish();
     let d = &diagnosis;
     let report = Report {

@@ -4,6 +4,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 mod bands;
+mod batch;
 mod commands;
 mod detect;
 mod diagnose;
@@ -255,6 +256,9 @@ enum Command {
     FitFrf(measured::FitFrfArgs),
     /// Tool-tip FRF of a tool-holder-spindle assembly by receptance coupling (RCSA).
     Rcsa(rcsa::RcsaArgs),
+    /// Diagnose and plan every machine-tool campaign of a fleet manifest in parallel: one table
+    /// row per campaign (verdict, boundary shift, next test).
+    Batch(batch::BatchArgs),
     /// Run the main job on the embedded examples and write the results to a folder.
     Demo {
         /// Output folder.
@@ -454,6 +458,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Oma(args) => oma::run(&args),
         Command::FitFrf(args) => measured::fit_frf(&args),
         Command::Rcsa(args) => rcsa::rcsa(&args),
+        Command::Batch(args) => batch::run(&args, quiet),
         Command::Demo { out } => commands::demo(&out, quiet),
     }
 }
@@ -479,6 +484,19 @@ fn command() -> clap::Command {
         }
         sub
     })
+}
+
+/// A job's error in the command line's words: an invalid request field is reported as its
+/// option (`samples` as `--samples`), the rest as it is.
+pub fn job_error(e: chatter_jobs::JobError) -> anyhow::Error {
+    match e {
+        chatter_jobs::JobError::Invalid {
+            field,
+            value,
+            expected,
+        } => anyhow::anyhow!("--{} {value}: expected {expected}", field.replace('_', "-")),
+        other => other.into(),
+    }
 }
 
 /// The error and its causes on one line, each cause once: a cause whose text its parent

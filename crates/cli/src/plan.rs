@@ -3,9 +3,10 @@
 
 use crate::progress::Bar;
 use anyhow::{Context, Result};
+use chatter_jobs::plan::PlanRequest;
 use chatter_updating::ensemble::EnsembleObserver;
 use chatter_updating::parameters::parse_model_parameters;
-use chatter_updating::plan::{PlanSettings, Strategy, plan_next_cut};
+use chatter_updating::plan::Strategy;
 use chatter_updating::update::PriorOverrides;
 use std::path::PathBuf;
 
@@ -128,7 +129,7 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         }
         None => PriorOverrides::new(),
     };
-    let settings = PlanSettings {
+    let request = PlanRequest {
         strategy: match args.strategy {
             StrategyArg::Voi => Strategy::ValueOfInformation,
             StrategyArg::Mrr => Strategy::MaterialRemovalRate,
@@ -143,24 +144,20 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         target: args.target.as_deref().map(str::parse).transpose()?,
         paths: args.paths,
         speeds_rpm: speeds,
-        depths_m: depths.map(|d| {
-            d.into_iter()
-                .filter(|v| *v > 0.0)
-                .map(|v| v * 1e-3)
-                .collect()
-        }),
-        feed_per_tooth_m: args.feed_per_tooth_mm * 1e-3,
+        depths_mm: depths,
+        feed_per_tooth_mm: args.feed_per_tooth_mm,
         seed: args.seed,
         max_tests: args.max_tests,
     };
     let progress = PathProgress(Bar::new(args.paths as u64, "sampled boundaries", quiet));
-    let outcome = plan_next_cut(&model, &observations, &settings, &progress)?;
+    let outcome = chatter_jobs::plan::plan(&model, &observations, &request, &progress)
+        .map_err(crate::job_error)?;
     progress.0.finish();
     if let Some(t) = outcome.next_cut.filter(|t| t.on_contour == Some(false)) {
         eprintln!(
             "warning: the P_s = {} contour at {} rpm lies above the deepest candidate depth; \
              proposing {} mm there (P_s {:.3}), not a cut on the contour: give deeper --depths",
-            settings.p_test, t.speed_rpm, t.depth_mm, t.p_stable
+            request.p_test, t.speed_rpm, t.depth_mm, t.p_stable
         );
     }
     let strategy = match args.strategy {
@@ -176,7 +173,7 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
             &model,
             &observations,
             &outcome,
-            (!voi).then_some(settings.p_test),
+            (!voi).then_some(request.p_test),
             crate::report::jobs::plan_plot(&observations, &outcome),
         )?
         .write(path)?;

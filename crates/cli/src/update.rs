@@ -5,9 +5,10 @@ use crate::output::Folder;
 use crate::progress::Bar;
 use anyhow::{Context, Result, anyhow, bail};
 use chatter_bayes::tmcmc::SamplerObserver;
-use chatter_updating::classes::{ClassObserver, Sampler, SamplerOptions};
+use chatter_jobs::update::{PreparedUpdate, UpdateRequest};
+use chatter_updating::classes::{ClassObserver, Sampler};
 use chatter_updating::parameters::parse_model_parameters;
-use chatter_updating::update::{PriorOverrides, UpdateJob, UpdateResult, UpdateSettings};
+use chatter_updating::update::{PriorOverrides, UpdateResult};
 use plotters::prelude::*;
 use std::path::PathBuf;
 
@@ -147,19 +148,6 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         }
         None => PriorOverrides::new(),
     };
-    let settings = UpdateSettings {
-        parameters: args
-            .parameters
-            .as_deref()
-            .map(parse_model_parameters)
-            .transpose()?,
-        priors,
-        classes: args.classes.as_deref().map(parse_classes).transpose()?,
-        surrogate_training_points: match args.surrogate {
-            Some(SurrogateArg::Gp) | None => Some(args.surrogate_points),
-            Some(SurrogateArg::Exact) => None,
-        },
-    };
     crate::validate::count(
         "--surrogate-points",
         args.surrogate_points,
@@ -167,16 +155,7 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         1_000_000,
         "GP training points",
     )?;
-    let job = UpdateJob::new(&model, &observations, &settings)?;
-    if args.classes.is_some() && job.alphas().is_empty() {
-        bail!(
-            "--classes is not used with these observations: {} has no poles, and the cut \
-             likelihood (004) has no model classes",
-            args.observations.display()
-        );
-    }
-    crate::validate::observation_work_size(&model, &observations, &args.observations)?;
-    let options = SamplerOptions {
+    let request = UpdateRequest {
         sampler: match args.sampler {
             SamplerArg::Itmcmc => Sampler::Itmcmc,
             SamplerArg::Tmcmc => Sampler::Tmcmc,
@@ -184,14 +163,28 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         },
         samples: args.samples,
         seed: args.seed,
+        parameters: args
+            .parameters
+            .as_deref()
+            .map(parse_model_parameters)
+            .transpose()?,
+        priors,
+        classes: args.classes.as_deref().map(parse_classes).transpose()?,
+        surrogate_points: match args.surrogate {
+            Some(SurrogateArg::Gp) | None => Some(args.surrogate_points),
+            Some(SurrogateArg::Exact) => None,
+        },
     };
+    let job = PreparedUpdate::new(&model, &observations, request).map_err(crate::job_error)?;
+    crate::validate::observation_work_size(&model, &observations, &args.observations)?;
     let progress = ClassProgress(Bar::new(
-        job.alphas().len().max(1) as u64,
+        job.job().alphas().len().max(1) as u64,
         "model classes",
         quiet,
     ));
-    let result = job.run(&options, &progress)?;
+    let outcome = job.run(&progress).map_err(crate::job_error)?;
     progress.0.finish();
+    let result = outcome.result;
     for c in &result.classes {
         if let Some(n) = c.numerical_failures.filter(|&n| n > 0) {
             let class = c.alpha.map_or(String::new(), |a| format!(" alpha {a}"));
@@ -219,8 +212,7 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     for p in &result.prior_bound_pileups {
         eprintln!("warning: {}", crate::report::jobs::pileup_warning(p));
     }
-    let prior = job.prior_draws(PRIOR_DRAWS, args.seed);
-    let figures = write_outputs(folder, &result, &model, &prior)?;
+    let figures = write_outputs(folder, &result, &model, &outcome.prior_draws)?;
     match &args.report {
         Some(path) => {
             crate::report::jobs::update(&model, &observations, &result, &figures)?.write(path)
@@ -228,9 +220,6 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         None => Ok(()),
     }
 }
-
-/// Prior draws shown in the corner plot.
-const PRIOR_DRAWS: usize = 2000;
 
 /// Write the result into its folder; returns the plots written (name, SVG) for the report page.
 fn write_outputs(

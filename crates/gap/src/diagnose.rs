@@ -254,6 +254,18 @@ pub struct ClassReport {
     pub solver_failures: usize,
     /// Whether failures exceed 1 % of the evaluations: the class's evidence is then unreliable.
     pub failures_flagged: bool,
+    /// The posterior samples in physical parameters (for ArviZ; not in the JSON report).
+    #[serde(skip)]
+    pub posterior: ClassPosterior,
+}
+
+/// A class's posterior samples in its physical parameters.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ClassPosterior {
+    /// Parameter names (units in the names), the columns of `samples`.
+    pub parameter_names: Vec<String>,
+    /// One row per equally weighted iTMCMC sample.
+    pub samples: Vec<Vec<f64>>,
 }
 
 /// Share of failed evaluations above which a class is flagged.
@@ -619,6 +631,7 @@ pub fn diagnose(
             evaluations: f.evaluations,
             solver_failures: f.failures,
             failures_flagged: f.failures as f64 > MAX_FAILURE_RATE * f.evaluations.max(1) as f64,
+            posterior: posterior(f),
         })
         .collect();
     let (diagnosed, diagnosed_prediction) = if consistent {
@@ -670,6 +683,27 @@ pub fn diagnose(
 }
 
 /// Posterior mean and standard deviation of every physical parameter of a fitted class.
+/// The class's samples in physical parameters.
+fn posterior(f: &Fitted) -> ClassPosterior {
+    let rows: Vec<Vec<(&'static str, f64)>> = f
+        .run
+        .samples
+        .samples()
+        .iter()
+        .map(|t| f.model.physical(t))
+        .collect();
+    ClassPosterior {
+        parameter_names: rows
+            .first()
+            .map(|r| r.iter().map(|(n, _)| (*n).to_string()).collect())
+            .unwrap_or_default(),
+        samples: rows
+            .iter()
+            .map(|r| r.iter().map(|(_, v)| *v).collect())
+            .collect(),
+    }
+}
+
 fn summaries(f: &Fitted) -> BTreeMap<String, ParameterSummary> {
     let rows: Vec<Vec<(&'static str, f64)>> = f
         .run

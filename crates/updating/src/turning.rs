@@ -438,6 +438,28 @@ impl TurningPoleLikelihood {
         self.try_ln_likelihood(theta).unwrap_or(f64::NEG_INFINITY)
     }
 
+    /// The terms of Eq. 31 one identified pole at a time (nats; they sum to
+    /// [`Self::try_ln_likelihood`] up to rounding), with this likelihood's normalization of the
+    /// residuals; NaN for every pole where there is no likelihood (outside the support, solver
+    /// failure). For pointwise model comparison (LOO, WAIC).
+    pub fn pointwise_ln_likelihood(&self, theta: &[f64]) -> Vec<f64> {
+        let failed = vec![f64::NAN; self.poles.len()];
+        let Some((&var_r, theta_m)) = theta.split_last() else {
+            return failed;
+        };
+        if self.try_ln_likelihood(theta).is_err() {
+            return failed;
+        }
+        let Ok(res) = self.normalized_residuals(theta_m) else {
+            return failed;
+        };
+        let var_i = self.alpha * var_r;
+        let norm = (2.0 * PI * (var_r * var_i).sqrt()).ln();
+        res.iter()
+            .map(|(r, i)| -0.5 * (r * r / var_r + i * i / var_i) - norm)
+            .collect()
+    }
+
     /// ln p(D | theta, M(alpha)) (Eq. 31), or why there is none: outside the support where the
     /// parameters make no valid model, numerical where the root solver fails.
     pub fn try_ln_likelihood(&self, theta: &[f64]) -> std::result::Result<f64, LikelihoodFailure> {

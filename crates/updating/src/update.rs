@@ -389,6 +389,69 @@ impl UpdateJob {
 }
 
 impl UpdateJob {
+    /// ln p(d_i | theta, M_alpha) of every observation d_i alone at every sample theta (rows:
+    /// samples, columns: the identified poles with their repetitions expanded, or the cuts):
+    /// the pointwise log-likelihood that LOO and WAIC need. The observations are independent
+    /// given theta (000 Eq. 28-31, 002 Eq. 14-15, 004 Eq. 5), so a row sums to ln p(D | theta)
+    /// (checked for turning poles, whose terms share the set's residual normalization; milling
+    /// poles and cuts are evaluated one observation at a time). Milling poles use the exact
+    /// multipliers, not the surrogate. `alpha` is the class (ignored for cuts, which have none).
+    pub fn pointwise_log_likelihood(
+        &self,
+        alpha: Option<f64>,
+        samples: &[Vec<f64>],
+    ) -> Result<Vec<Vec<f64>>> {
+        use chatter_bayes::LogLikelihood;
+        use rayon::prelude::*;
+        let p = &self.parameterization;
+        let alpha = alpha.unwrap_or(1.0);
+        let singles: Vec<Box<dyn LogLikelihood>> = match &self.data {
+            Data::Cuts(cuts) => cuts
+                .iter()
+                .map(|c| {
+                    CutsLikelihood::new(
+                        p.clone(),
+                        vec![c.clone()],
+                        CutKernel::schmitz(),
+                        BoundaryOptions::default(),
+                    )
+                    .map(|l| Box::new(l) as Box<dyn LogLikelihood>)
+                })
+                .collect::<Result<_>>()?,
+            Data::TurningPoles(poles) => {
+                // one likelihood of all poles: its residual normalization is the set's
+                let all = TurningPoleLikelihood::new(
+                    p.clone(),
+                    poles.clone(),
+                    alpha,
+                    ResidualForm::PoleError,
+                )?;
+                return Ok(samples
+                    .par_iter()
+                    .map(|theta| all.pointwise_ln_likelihood(theta))
+                    .collect());
+            }
+            Data::MillingPoles(poles) => poles
+                .iter()
+                .map(|o| {
+                    MillingPoleLikelihood::new(
+                        p.clone(),
+                        std::slice::from_ref(o),
+                        alpha,
+                        Discretization::full(),
+                    )
+                    .map(|l| Box::new(l) as Box<dyn LogLikelihood>)
+                })
+                .collect::<Result<_>>()?,
+        };
+        Ok(samples
+            .par_iter()
+            .map(|theta| singles.iter().map(|l| l.ln_likelihood(theta)).collect())
+            .collect())
+    }
+}
+
+impl UpdateJob {
     /// (frequency Hz, damping) of the model's pole at every identified condition for `theta_m`
     /// (exact: the characteristic root nearest the identified pole in turning, the dominant
     /// multiplier of the monodromy in milling), in the order of `self.poles`.
@@ -512,6 +575,36 @@ mod tests {
     use super::*;
     use crate::classes::{Sampler, Silent};
     use chatter_dynamics::examples;
+
+    #[test]
+    fn pointwise_log_likelihood_sums_to_the_likelihood_of_all_poles() {
+        let model = examples::ahmadi_2022_turning();
+        let obs = examples::ahmadi_2022_turning_observations();
+        let job = UpdateJob::new(&model, &obs, &UpdateSettings::default()).unwrap();
+        let Data::TurningPoles(poles) = &job.data else {
+            panic!("seed 000 updates on turning poles")
+        };
+        let alpha = job.alphas()[3];
+        let all = TurningPoleLikelihood::new(
+            job.parameterization.clone(),
+            poles.clone(),
+            alpha,
+            ResidualForm::PoleError,
+        )
+        .unwrap();
+        let thetas = job.prior_draws(4, 1);
+        let rows = job.pointwise_log_likelihood(Some(alpha), &thetas).unwrap();
+        for (theta, row) in thetas.iter().zip(&rows) {
+            assert_eq!(row.len(), poles.len());
+            let total: f64 = row.iter().sum();
+            let expected = all.ln_likelihood(theta);
+            // the same terms summed in another order: rounding only
+            assert!(
+                (total - expected).abs() <= 1e-9 * expected.abs().max(1.0),
+                "{total} vs {expected}"
+            );
+        }
+    }
 
     #[test]
     fn priors_files_parse_strictly_and_name_checks_hold() {

@@ -1,0 +1,309 @@
+//! Fleet runs: a manifest of machine-tool campaigns (one model and one observations file per
+//! line), each campaign reduced to one row (verdict, shift of the boundary, next test), and the
+//! batch over a manifest in parallel with deterministic results.
+//!
+//! # Manifest
+//! CSV with the header `name,model,observations,seed`, one campaign per line; paths are relative
+//! to the manifest's folder, `seed` seeds that campaign's samplers (so a row does not depend on
+//! the order of the lines, the thread count or the machine it ran on):
+//!
+//! ```text
+//! name,model,observations,seed
+//! lathe-7/insert-A,lathe7.json,lathe7_2026-11-24.json,1
+//! ```
+//!
+//! # One campaign
+//! [`run_campaign`]: the gap diagnosis of the observations against the model
+//! ([`crate::diagnose`]); the boundary shift is the median over the cut speeds of the diagnosed
+//! machine's limiting depth over the nominal one, minus one, in percent; the next test is the
+//! maximum material-removal-rate cut on the P_s = 0.5 contour of the diagnosed machine given the
+//! cuts so far ([`crate::plan`], 004), or `stop` when testing should stop.
+
+use crate::diagnose::{DiagnoseRequest, diagnose};
+use crate::error::{JobError, Result};
+use crate::plan::{PlanRequest, plan};
+use chatter_dynamics::{ModalModel, Observations};
+use chatter_gap::Validation;
+use chatter_updating::plan::Strategy;
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// One line of a manifest.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Campaign {
+    /// Name of the machine-tool combination (the table's key).
+    pub name: String,
+    /// Model file.
+    pub model: PathBuf,
+    /// Observations file.
+    pub observations: PathBuf,
+    /// Seed of the campaign's samplers.
+    pub seed: u64,
+}
+
+/// Read a manifest; paths become relative to the current folder.
+pub fn read_manifest(path: &Path) -> Result<Vec<Campaign>> {
+    let file_error = |message: String| JobError::File {
+        path: path.display().to_string(),
+        message,
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| file_error(format!("cannot read the manifest: {e}")))?;
+    let header = reader
+        .headers()
+        .map_err(|e| file_error(e.to_string()))?
+        .clone();
+    if header.iter().collect::<Vec<_>>() != ["name", "model", "observations", "seed"] {
+        return Err(file_error(format!(
+            "header `{}`: expected `name,model,observations,seed`",
+            header.iter().collect::<Vec<_>>().join(",")
+        )));
+    }
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut campaigns: Vec<Campaign> = Vec::new();
+    for (i, row) in reader.deserialize::<Campaign>().enumerate() {
+        let mut c = row.map_err(|e| file_error(format!("line {}: {e}", i + 2)))?;
+        if campaigns.iter().any(|o| o.name == c.name) {
+            return Err(file_error(format!(
+                "line {}: name `{}` is given twice; expected one line per campaign",
+                i + 2,
+                c.name
+            )));
+        }
+        c.model = base.join(&c.model);
+        c.observations = base.join(&c.observations);
+        campaigns.push(c);
+    }
+    if campaigns.is_empty() {
+        return Err(file_error(
+            "no campaigns; expected one line per campaign".into(),
+        ));
+    }
+    Ok(campaigns)
+}
+
+/// How much work a campaign gets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CampaignOptions {
+    /// iTMCMC samples per effect class of the diagnosis.
+    pub samples: usize,
+    /// Held-out validation of the diagnosis (the row does not use it: off by default).
+    pub validation: Validation,
+    /// Sampled boundaries of the next-test plan.
+    pub paths: usize,
+}
+
+impl Default for CampaignOptions {
+    /// The diagnosis's 120 samples per class without validation, 300 planning paths.
+    fn default() -> Self {
+        Self {
+            samples: crate::diagnose::DEFAULT_SAMPLES,
+            validation: Validation::Off,
+            paths: PlanRequest::new(Strategy::MaterialRemovalRate).paths,
+        }
+    }
+}
+
+/// What a campaign concluded.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct CampaignRow {
+    /// The campaign's name.
+    pub name: String,
+    /// `consistent`, the effect class that explains the gap, or `unexplained`.
+    pub verdict: String,
+    /// Median over the cut speeds of diagnosed / nominal limiting depth - 1 (%).
+    pub boundary_shift_percent: f64,
+    /// Next test cut's speed (rpm), when one is proposed.
+    pub next_speed_rpm: Option<f64>,
+    /// Next test cut's depth (mm).
+    pub next_depth_mm: Option<f64>,
+    /// Probability that the next cut is stable.
+    pub next_p_stable: Option<f64>,
+    /// Testing should stop.
+    pub stop: bool,
+}
+
+/// Header of the batch table.
+pub const TABLE_HEADER: &str =
+    "name,verdict,boundary_shift_percent,next_speed_rpm,next_depth_mm,next_p_stable,stop,error";
+
+impl CampaignRow {
+    /// The row as a line of the batch table (without the newline; numbers in Rust's shortest
+    /// round-trip form, so equal tables mean bit-equal numbers).
+    pub fn csv_line(&self) -> String {
+        let cell = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+        format!(
+            "{},{},{},{},{},{},{},",
+            quote(&self.name),
+            self.verdict,
+            self.boundary_shift_percent,
+            cell(self.next_speed_rpm),
+            cell(self.next_depth_mm),
+            cell(self.next_p_stable),
+            self.stop
+        )
+    }
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+fn quote(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// The line of a campaign that failed: its name and the error, other cells empty.
+pub fn error_line(name: &str, error: &str) -> String {
+    format!("{},,,,,,,{}", quote(name), quote(error))
+}
+
+/// Diagnose one campaign already read and plan its next test.
+pub fn campaign_row(
+    name: &str,
+    model: &ModalModel,
+    observations: &Observations,
+    seed: u64,
+    options: &CampaignOptions,
+) -> Result<CampaignRow> {
+    let request = DiagnoseRequest {
+        seed,
+        samples: options.samples,
+        validation: options.validation,
+    };
+    let diagnosis = diagnose(model, observations, &request, &chatter_gap::diagnose::Quiet)?;
+    let mut speeds = observations.speeds_rpm();
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup();
+    let mut ratios: Vec<f64> = diagnosis
+        .lobes(&speeds)
+        .iter()
+        .map(|l| l.diagnosed_mm / l.nominal_mm - 1.0)
+        .filter(|r| r.is_finite())
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let shift = match ratios.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => ratios[n / 2],
+        n => 0.5 * (ratios[n / 2 - 1] + ratios[n / 2]),
+    };
+    let mut plan_request = PlanRequest::new(Strategy::MaterialRemovalRate);
+    plan_request.paths = options.paths;
+    plan_request.seed = seed;
+    let outcome = plan(
+        diagnosis.diagnosed_model(),
+        observations,
+        &plan_request,
+        &chatter_updating::ensemble::Silent,
+    )?;
+    let next = outcome.next_cut.filter(|_| !outcome.stop);
+    Ok(CampaignRow {
+        name: name.to_string(),
+        verdict: diagnosis.verdict.name().to_string(),
+        boundary_shift_percent: 100.0 * shift,
+        next_speed_rpm: next.map(|t| t.speed_rpm),
+        next_depth_mm: next.map(|t| t.depth_mm),
+        next_p_stable: next.map(|t| t.p_stable),
+        stop: outcome.stop,
+    })
+}
+
+/// Read a campaign's files and reduce it to a row.
+pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<CampaignRow> {
+    let model = ModalModel::from_path(&campaign.model)?;
+    let observations = Observations::from_path(&campaign.observations)?;
+    campaign_row(
+        &campaign.name,
+        &model,
+        &observations,
+        campaign.seed,
+        options,
+    )
+}
+
+/// The table line of a campaign: its row, or its error (a failed campaign does not stop the
+/// batch).
+pub fn campaign_line(campaign: &Campaign, options: &CampaignOptions) -> String {
+    match run_campaign(campaign, options) {
+        Ok(row) => row.csv_line(),
+        Err(e) => error_line(&campaign.name, &e.to_string()),
+    }
+}
+
+/// Every campaign in parallel (rayon), the table in manifest order: the header, then one line
+/// per campaign. Each campaign is seeded by its own line, so the table does not depend on the
+/// number of threads; `done(k, total)` hears of each finished campaign.
+pub fn run_batch(
+    campaigns: &[Campaign],
+    options: &CampaignOptions,
+    done: &(dyn Fn(usize, usize) + Sync),
+) -> String {
+    let finished = std::sync::atomic::AtomicUsize::new(0);
+    let lines: Vec<String> = campaigns
+        .par_iter()
+        .map(|c| {
+            let line = campaign_line(c, options);
+            let k = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            done(k, campaigns.len());
+            line
+        })
+        .collect();
+    table(&lines)
+}
+
+/// The batch table of lines in order.
+pub fn table(lines: &[String]) -> String {
+    let mut text = String::from(TABLE_HEADER);
+    text.push('\n');
+    for line in lines {
+        let _ = writeln!(text, "{line}");
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn manifest_paths_are_relative_to_its_folder_and_names_unique() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("fleet.csv");
+        std::fs::write(&path, "name,model,observations,seed\na,m.json,o.json,3\n").unwrap();
+        let c = read_manifest(&path).unwrap();
+        assert_eq!(c.len(), 1);
+        assert_eq!(c[0].model, dir.path().join("m.json"));
+        assert_eq!(c[0].seed, 3);
+        std::fs::write(&path, "name,model,observations,seed\na,m,o,1\na,m,o,2\n").unwrap();
+        let e = read_manifest(&path).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("twice"), "{e}");
+        std::fs::write(&path, "model,observations\nm,o\n").unwrap();
+        let e = read_manifest(&path).unwrap_err().to_string();
+        assert!(e.contains("expected `name,model,observations,seed`"), "{e}");
+        std::fs::write(&path, "name,model,observations,seed\na,m,o,-1\n").unwrap();
+        let e = read_manifest(&path).unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+    }
+
+    #[test]
+    fn a_failed_campaign_is_a_row_with_its_error() {
+        let c = Campaign {
+            name: "x,1".into(),
+            model: "/nonexistent/m.json".into(),
+            observations: "/nonexistent/o.json".into(),
+            seed: 0,
+        };
+        let line = campaign_line(&c, &CampaignOptions::default());
+        assert!(line.starts_with("\"x,1\",,,,,,,"), "{line}");
+        assert!(line.contains("m.json"), "{line}");
+        let t = table(&[line]);
+        assert_eq!(t.lines().next(), Some(TABLE_HEADER));
+        assert_eq!(t.lines().count(), 2);
+    }
+}

@@ -1,0 +1,61 @@
+//! The one error type of `chatter-jobs`.
+
+/// What can go wrong in a job: its inputs, or the science crate it calls.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// A request field is out of range or inconsistent.
+    #[error("{field} {value}: expected {expected}")]
+    Invalid {
+        /// The field: the Python keyword, the CLI option `--field` with hyphens.
+        field: &'static str,
+        /// The value as given.
+        value: String,
+        /// What was expected.
+        expected: String,
+    },
+    /// A file could not be read.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// Model or observations.
+    #[error(transparent)]
+    Dynamics(#[from] chatter_dynamics::DynamicsError),
+    /// Stability.
+    #[error(transparent)]
+    Stability(#[from] chatter_stability::StabilityError),
+    /// Updating and planning.
+    #[error(transparent)]
+    Updating(#[from] chatter_updating::UpdatingError),
+    /// Uncertainty bands.
+    #[error(transparent)]
+    Uncertainty(#[from] chatter_uncertainty::UncertaintyError),
+    /// Gap diagnosis.
+    #[error(transparent)]
+    Gap(#[from] chatter_gap::GapError),
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, JobError>;
+
+/// `value` of `field` when `min <= value <= max`, else [`JobError::Invalid`].
+pub fn count(
+    field: &'static str,
+    value: usize,
+    min: usize,
+    max: usize,
+    what: &str,
+) -> Result<usize> {
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        Err(JobError::Invalid {
+            field,
+            value: value.to_string(),
+            expected: format!("{what} from {min} to {max}"),
+        })
+    }
+}

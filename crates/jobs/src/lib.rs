@@ -1,0 +1,20 @@
+//! The jobs of the `chatter` program as library functions: each takes a model, observations and
+//! a request in the units users write, checks the request, runs the science crates and returns
+//! a result struct. The command-line program and the Python package both call these, so the
+//! same request gives the same numbers bit for bit; they differ only in how they parse and
+//! write.
+//!
+//! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
+//! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]).
+//! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
+//! - [`bands`]: lobes, Type B offsets (001), credibility bounds (000), Monte Carlo (004).
+//! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
+
+pub mod bands;
+pub mod campaign;
+pub mod diagnose;
+pub mod error;
+pub mod plan;
+pub mod update;
+
+pub use error::{JobError, Result};

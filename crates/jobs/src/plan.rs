@@ -1,0 +1,99 @@
+//! The planning job (`chatter plan`, `chatter.plan`): the request in the units users write
+//! (rpm, mm) converted once to [`PlanSettings`] for [`plan_next_cut`].
+
+use crate::error::{JobError, Result, count};
+use chatter_dynamics::{ModalModel, Observations};
+use chatter_updating::ensemble::EnsembleObserver;
+use chatter_updating::parameters::ModelParameter;
+use chatter_updating::plan::{PlanOutcome, PlanSettings, Strategy, plan_next_cut};
+use chatter_updating::update::PriorOverrides;
+
+/// What a plan was asked, in rpm and mm; [`PlanRequest::new`] gives the CLI's defaults.
+#[derive(Debug, Clone)]
+pub struct PlanRequest {
+    /// Value of information (003) or material removal rate on the P_test contour (004).
+    pub strategy: Strategy,
+    /// P_test of the contour (mrr); default 0.5.
+    pub p_test: f64,
+    /// Sampled parameters (default kt, kn and C with process damping).
+    pub parameters: Option<Vec<ModelParameter>>,
+    /// Priors by name.
+    pub priors: PriorOverrides,
+    /// The parameter whose uncertainty value of information reduces.
+    pub target: Option<ModelParameter>,
+    /// Sampled stability boundaries (10 to 100 000).
+    pub paths: usize,
+    /// Candidate speeds (rpm); default the cut speeds +- 25 %.
+    pub speeds_rpm: Option<Vec<f64>>,
+    /// Candidate depths (mm); default up to twice the deepest cut. Depths <= 0 are dropped.
+    pub depths_mm: Option<Vec<f64>>,
+    /// Feed per tooth (mm) of the material removal rate.
+    pub feed_per_tooth_mm: f64,
+    /// Seed of the prior samples.
+    pub seed: u64,
+    /// Cap on test cuts.
+    pub max_tests: usize,
+}
+
+impl PlanRequest {
+    /// 300 paths, P_test 0.5, feed 0.1 mm, the default cap, seed 0.
+    pub fn new(strategy: Strategy) -> Self {
+        let d = PlanSettings::default();
+        Self {
+            strategy,
+            p_test: d.p_test,
+            parameters: None,
+            priors: PriorOverrides::new(),
+            target: None,
+            paths: d.paths,
+            speeds_rpm: None,
+            depths_mm: None,
+            feed_per_tooth_mm: d.feed_per_tooth_m * 1e3,
+            seed: d.seed,
+            max_tests: d.max_tests,
+        }
+    }
+
+    /// The settings in SI units.
+    pub fn settings(&self) -> Result<PlanSettings> {
+        count("paths", self.paths, 10, 100_000, "sampled boundaries")?;
+        if !(self.p_test > 0.0 && self.p_test < 1.0) {
+            return Err(JobError::Invalid {
+                field: "p_test",
+                value: self.p_test.to_string(),
+                expected: "a probability between 0 and 1".into(),
+            });
+        }
+        Ok(PlanSettings {
+            strategy: self.strategy,
+            p_test: self.p_test,
+            parameters: self.parameters.clone(),
+            priors: self.priors.clone(),
+            target: self.target,
+            paths: self.paths,
+            speeds_rpm: self.speeds_rpm.clone(),
+            depths_m: self
+                .depths_mm
+                .as_ref()
+                .map(|d| d.iter().filter(|v| **v > 0.0).map(|v| v * 1e-3).collect()),
+            feed_per_tooth_m: self.feed_per_tooth_mm * 1e-3,
+            seed: self.seed,
+            max_tests: self.max_tests,
+        })
+    }
+}
+
+/// The next test cut.
+pub fn plan(
+    model: &ModalModel,
+    observations: &Observations,
+    request: &PlanRequest,
+    observer: &dyn EnsembleObserver,
+) -> Result<PlanOutcome> {
+    Ok(plan_next_cut(
+        model,
+        observations,
+        &request.settings()?,
+        observer,
+    )?)
+}

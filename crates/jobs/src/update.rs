@@ -1,0 +1,124 @@
+//! The updating job (`chatter update`, `chatter.update`): the papers' likelihoods over model
+//! classes ([`chatter_updating::update::UpdateJob`]) with the request's sampler, samples and
+//! seed, plus the prior draws shown beside the posterior.
+
+use crate::error::{Result, count};
+use chatter_dynamics::{ModalModel, Observations};
+use chatter_updating::classes::{ClassObserver, Sampler, SamplerOptions};
+use chatter_updating::parameters::ModelParameter;
+use chatter_updating::update::{PriorOverrides, UpdateJob, UpdateResult, UpdateSettings};
+
+/// Prior draws returned beside the posterior (the corner plot's grey cloud, ArviZ's `prior`).
+pub const PRIOR_DRAWS: usize = 2000;
+/// Default samples per class.
+pub const DEFAULT_SAMPLES: usize = 5000;
+/// Most samples per class.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
+/// What an update was asked; [`UpdateRequest::new`] gives the CLI's defaults.
+#[derive(Debug, Clone)]
+pub struct UpdateRequest {
+    /// Posterior sampler.
+    pub sampler: Sampler,
+    /// Samples per class (10 to 1 000 000).
+    pub samples: usize,
+    /// Seed of the sampler and of the prior draws.
+    pub seed: u64,
+    /// Parameters to update (default: the papers').
+    pub parameters: Option<Vec<ModelParameter>>,
+    /// Priors by parameter name.
+    pub priors: PriorOverrides,
+    /// Model classes alpha (default: the papers').
+    pub classes: Option<Vec<f64>>,
+    /// Milling poles: GP surrogate training points (`None`: the exact multiplier per sample).
+    pub surrogate_points: Option<usize>,
+}
+
+impl UpdateRequest {
+    /// iTMCMC, 5000 samples per class, the papers' parameters, priors and classes, the GP
+    /// surrogate with its default training points.
+    pub fn new(seed: u64) -> Self {
+        Self {
+            sampler: Sampler::Itmcmc,
+            samples: DEFAULT_SAMPLES,
+            seed,
+            parameters: None,
+            priors: PriorOverrides::new(),
+            classes: None,
+            surrogate_points: Some(chatter_updating::surrogate::DEFAULT_TRAINING_POINTS),
+        }
+    }
+}
+
+/// A prepared update: the validated job and the request.
+#[derive(Debug, Clone)]
+pub struct PreparedUpdate {
+    job: UpdateJob,
+    request: UpdateRequest,
+}
+
+/// The posterior with the prior draws.
+#[derive(Debug, Clone)]
+pub struct UpdateOutcome {
+    /// Samples, classes, evidence, updated model.
+    pub result: UpdateResult,
+    /// [`PRIOR_DRAWS`] draws of the prior of the sampled parameters, seeded by the request.
+    pub prior_draws: Vec<Vec<f64>>,
+}
+
+impl PreparedUpdate {
+    /// Validate the request against the model and observations (cheap: nothing sampled).
+    pub fn new(
+        model: &ModalModel,
+        observations: &Observations,
+        request: UpdateRequest,
+    ) -> Result<Self> {
+        count(
+            "samples",
+            request.samples,
+            10,
+            MAX_SAMPLES,
+            "samples per class",
+        )?;
+        if let Some(n) = request.surrogate_points {
+            count("surrogate_points", n, 10, 1_000_000, "GP training points")?;
+        }
+        let settings = UpdateSettings {
+            parameters: request.parameters.clone(),
+            priors: request.priors.clone(),
+            classes: request.classes.clone(),
+            surrogate_training_points: request.surrogate_points,
+        };
+        let job = UpdateJob::new(model, observations, &settings)?;
+        if request.classes.is_some() && job.alphas().is_empty() {
+            return Err(crate::JobError::Invalid {
+                field: "classes",
+                value: format!("{:?}", request.classes.as_deref().unwrap_or_default()),
+                expected: "no classes: the observations have no poles, and the cut likelihood \
+                           (004) has no model classes"
+                    .into(),
+            });
+        }
+        Ok(Self { job, request })
+    }
+
+    /// The validated job (parameter names, classes, prior).
+    pub fn job(&self) -> &UpdateJob {
+        &self.job
+    }
+
+    /// Sample every class, summarize the selected one, draw the prior.
+    pub fn run(&self, observer: &dyn ClassObserver) -> Result<UpdateOutcome> {
+        let options = SamplerOptions {
+            sampler: self.request.sampler,
+            samples: self.request.samples,
+            seed: self.request.seed,
+        };
+        let result = self.job.run(&options, observer)?;
+        let prior_draws = self.job.prior_draws(PRIOR_DRAWS, self.request.seed);
+        Ok(UpdateOutcome {
+            result,
+            prior_draws,
+        })
+    }
+}

@@ -1,0 +1,221 @@
+"""The Python package: inputs, the science calls against analytic or independent values, the
+numbers bit-equal to the command line's for the same seed, interruption, ArviZ output."""
+
+import _thread
+import csv
+import json
+import threading
+
+import numpy as np
+import pytest
+
+import chatter
+from conftest import MILLING_MODEL, TURNING_MODEL, TURNING_OBSERVATIONS
+
+
+def read_csv(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def cells(rows, key):
+    """A CSV column as floats, NaN for empty cells (exact: the CLI writes round-trip digits)."""
+    return np.array([float(r[key]) if r[key] != "" else np.nan for r in rows])
+
+
+def same(a, b):
+    """Bit-equal arrays, NaN equal to NaN."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
+
+
+# --- inputs ---------------------------------------------------------------------------------
+
+
+def test_model_from_path_and_from_dict_agree():
+    m = chatter.load_model(TURNING_MODEL)
+    assert [mode["frequency_hz"] for mode in m["modes"]] == [1842.0, 2445.0]
+    assert chatter.load_model(m) == m
+
+
+def test_bad_input_names_the_field_and_value():
+    d = json.loads(TURNING_MODEL.read_text())
+    d["modes"][0]["damping_ratio"] = -0.1
+    with pytest.raises(ValueError, match="damping_ratio"):
+        chatter.load_model(d)
+    with pytest.raises(ValueError, match="no_such.json"):
+        chatter.load_model("no_such.json")
+    with pytest.raises(ValueError, match='method "euler"'):
+        chatter.lobes(TURNING_MODEL, method="euler")
+    with pytest.raises(ValueError, match="samples 3"):
+        chatter.update(TURNING_MODEL, TURNING_OBSERVATIONS, seed=0, samples=3)
+
+
+def test_validate_summarizes_the_seed_000_files():
+    v = chatter.validate(TURNING_MODEL, TURNING_OBSERVATIONS)
+    assert v == {"operation": "turning", "modes": 2, "cuts": 7, "poles": 5, "signals": 0}
+
+
+# --- science against independent values -----------------------------------------------------
+
+
+def single_mode_turning(k=2e7, zeta=0.03, f_hz=800.0, kn=400.0):
+    """One mode along the feed, whose regenerative force is kn b h along the feed."""
+    return {
+        "operation": {"kind": "turning"},
+        "cutting": {"kt_n_per_mm2": 1000.0, "kn_n_per_mm2": kn},
+        "modes": [
+            {"frequency_hz": f_hz, "damping_ratio": zeta,
+             "direction": "feed", "stiffness_n_per_m": k}
+        ],
+    }
+
+
+def test_zero_order_lobe_minimum_is_the_single_mode_closed_form():
+    # b_lim,min = 2 k zeta (1 + zeta) / K (Tlusty; Altintas 2012 Eq. 3.17 at min Re G), in mm
+    k, zeta, kn = 2e7, 0.03, 400.0
+    expected_mm = 2 * k * zeta * (1 + zeta) / (kn * 1e6) * 1e3
+    speeds = np.linspace(2000.0, 20000.0, 4000)
+    lobes = chatter.lobes(single_mode_turning(k, zeta, kn=kn), speeds_rpm=speeds, method="zoa")
+    # the grid minimum lies within the lobe's flat bottom: 1e-3 relative
+    assert np.nanmin(lobes["depth_mm"]) == pytest.approx(expected_mm, rel=1e-3)
+
+
+def test_multiplier_crosses_one_at_the_limiting_depth():
+    # the lobes refine the discretization (Richardson) beyond the multiplier's fixed grid, so
+    # |mu| = 1 holds at the limit to the grid's accuracy (< 0.5 % in depth): 3 % either side
+    speeds = np.array([3000.0, 5000.0])
+    lobes = chatter.lobes(MILLING_MODEL, speeds_rpm=speeds, method="fdm")
+    for s, b in zip(speeds, lobes["depth_mm"]):
+        assert chatter.multiplier(MILLING_MODEL, float(s), 0.97 * float(b))["modulus"] < 1.0
+        assert chatter.multiplier(MILLING_MODEL, float(s), 1.03 * float(b))["modulus"] > 1.0
+
+
+def test_simulated_cuts_are_detected_stable_below_and_chatter_above_the_limit():
+    speed = 7000.0
+    limit = float(chatter.lobes(TURNING_MODEL, speeds_rpm=np.array([speed]))["depth_mm"][0])
+    verdicts = []
+    for ratio in (0.3, 2.0):
+        sim = chatter.simulate(TURNING_MODEL, speed, ratio * limit, duration_s=1.0,
+                               sample_rate_hz=20000.0, seed=1)
+        assert sim["names"][-1] == "once_per_rev"
+        assert sim["data"].shape == (3, 20000)
+        d = chatter.detect(sim["data"], sim["sample_rate_hz"], speed, names=sim["names"],
+                           once_per_rev_channel="once_per_rev")
+        verdicts.append(d["stable"])
+    assert verdicts == [True, False]
+
+
+# --- the same numbers as the command line ---------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def seed000_update(cli, tmp_path_factory):
+    out = tmp_path_factory.mktemp("update")
+    cli("update", "--model", TURNING_MODEL, "--observations", TURNING_OBSERVATIONS,
+        "--samples", 200, "--seed", 7, "--out", out)
+    py = chatter.update(TURNING_MODEL, TURNING_OBSERVATIONS, seed=7, samples=200)
+    return out, py
+
+
+def test_update_is_bit_identical_to_the_cli(seed000_update):
+    out, py = seed000_update
+    rows = read_csv(out / "posterior.csv")
+    names = py["parameter_names"]
+    assert list(rows[0].keys()) == names + ["weight"]
+    cli_samples = np.array([[float(r[n]) for n in names] for r in rows])
+    assert same(cli_samples, py["samples"])
+    assert same(cells(rows, "weight"), py["weights"])
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["selected_alpha"] == py["selected_alpha"]
+    assert [c["log_evidence"] for c in summary["classes"]] == \
+        [c["log_evidence"] for c in py["classes"]]
+    assert same(summary["posterior_covariance"], py["posterior_covariance"])
+
+
+def test_montecarlo_and_perturbation_bands_are_bit_identical_to_the_cli(cli, seed000_update, tmp_path):
+    posterior, _ = seed000_update
+    speeds = np.linspace(6900.0, 7500.0, 4)
+    spec = "6900:7500:4"
+    mc_csv = tmp_path / "mc.csv"
+    cli("bands", "--model", TURNING_MODEL, "--kind", "montecarlo", "--posterior", posterior,
+        "--samples", 12, "--seed", 3, "--speeds", spec, "--out", mc_csv)
+    mc = chatter.bands_montecarlo(TURNING_MODEL, str(posterior), speeds_rpm=speeds, samples=12,
+                                  seed=3)
+    rows = read_csv(mc_csv)
+    for key in ("speed_rpm", "depth_mm", "lower_mm", "upper_mm", "chatter_hz_q50"):
+        assert same(cells(rows, key), mc[key]), key
+    pt_csv = tmp_path / "pt.csv"
+    cli("bands", "--model", TURNING_MODEL, "--kind", "perturbation", "--posterior", posterior,
+        "--speeds", spec, "--depths", "0.05:3:30", "--out", pt_csv)
+    pt = chatter.bands_perturbation(TURNING_MODEL, str(posterior), speeds_rpm=speeds,
+                                    depths_mm=np.linspace(0.05, 3.0, 30))
+    rows = read_csv(pt_csv)
+    for key in ("speed_rpm", "depth_mm", "lower_mm", "upper_mm"):
+        assert same(cells(rows, key), pt[key]), key
+    # the bounds bracket the mean boundary where all three are reached
+    ok = ~np.isnan(pt["lower_mm"]) & ~np.isnan(pt["upper_mm"])
+    assert np.all(pt["lower_mm"][ok] <= pt["depth_mm"][ok])
+    assert np.all(pt["depth_mm"][ok] <= pt["upper_mm"][ok])
+
+
+def test_geometric_bands_and_plan_are_bit_identical_to_the_cli(cli, tmp_path):
+    # a grid whose points are exact in both spellings (150 rpm steps)
+    out = tmp_path / "geo.csv"
+    cli("bands", "--model", MILLING_MODEL, "--kind", "geometric", "--speeds", "3000:12000:61",
+        "--out", out)
+    py = chatter.bands_geometric(MILLING_MODEL, speeds_rpm=np.linspace(3000.0, 12000.0, 61))
+    rows = read_csv(out)
+    for key in ("speed_rpm", "depth_mm", "lower_mm", "upper_mm", "theta_deg", "distance"):
+        assert same(cells(rows, key), py[key]), key
+    text = cli("plan", "--model", TURNING_MODEL, "--observations", TURNING_OBSERVATIONS,
+               "--strategy", "mrr", "--paths", 20, "--seed", 4)
+    assert json.loads(text) == chatter.plan(TURNING_MODEL, TURNING_OBSERVATIONS, "mrr",
+                                            paths=20, seed=4)
+
+
+# --- interruption ---------------------------------------------------------------------------
+
+
+def test_a_long_call_is_interrupted_by_ctrl_c():
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        chatter.lobes(MILLING_MODEL, speeds_rpm=np.linspace(2000.0, 20000.0, 3000))
+    timer.join()
+
+
+# --- ArviZ ----------------------------------------------------------------------------------
+
+
+def test_update_inference_data_has_posterior_prior_and_pointwise_log_likelihood(seed000_update):
+    az = pytest.importorskip("arviz")
+    _, py = seed000_update
+    idata = chatter.update_inference_data(py)
+    assert {"posterior", "prior", "log_likelihood"} <= set(idata.groups())
+    names = py["parameter_names"]
+    assert list(idata.posterior.data_vars) == names
+    first = idata.posterior[names[0]].values[0]
+    assert same(first, py["samples"][:, 0])
+    ll = idata.log_likelihood["y"].values[0]
+    assert ll.shape[0] == len(py["samples"]) and ll.shape[1] >= 5  # every identified pole
+    assert np.all(np.isfinite(ll))
+    loo = az.loo(idata)
+    assert np.isfinite(loo.elpd_loo)
+    assert idata.attrs["selected_alpha"] == py["selected_alpha"]
+
+
+def test_diagnosis_inference_data_holds_each_class_posterior():
+    pytest.importorskip("arviz")
+    model, observations = chatter.synthetic_campaign("process_damping", 2.0, seed=5, cuts=8,
+                                                     pole_speeds=0)
+    d = chatter.diagnose(model, observations, seed=2, samples=40, validation="off")
+    by_class = chatter.diagnosis_inference_data(d)
+    assert set(by_class) == {c["name"] for c in d["classes"]}
+    for c in d["classes"]:
+        idata = by_class[c["name"]]
+        assert idata.attrs["log_evidence"] == c["log_evidence"]
+        for name, summary in c["parameters"].items():
+            # the report's mean and the InferenceData's: the same samples summed two ways
+            assert float(idata.posterior[name].mean()) == pytest.approx(summary["mean"],
+                                                                        rel=1e-9, abs=1e-12)
