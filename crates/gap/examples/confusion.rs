@@ -8,7 +8,7 @@
 //! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1
 //! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --verbose]`
 
-use chatter_gap::generator::{effect_at, proving_machines, true_variant};
+use chatter_gap::generator::{proving_machines, true_variant};
 use chatter_gap::predict::inference_solver;
 use chatter_gap::{
     DiagnoseOptions, DiagnosisObserver, EffectClass, HiddenEffect, Recalibration, Scenario,
@@ -101,23 +101,7 @@ fn main() -> chatter_gap::Result<()> {
     for &mi in &pick {
         let machine = &machines[mi];
         let (lo, hi) = machine.speed_range_rpm;
-        let mut cases: Vec<(String, String, HiddenEffect, Recalibration)> = vec![(
-            "control".into(),
-            "control".into(),
-            HiddenEffect::ParameterError,
-            Recalibration::default(),
-        )];
-        for &class in &classes {
-            if class == EffectClass::ProcessDamping
-                && machine.model.operation().cutting_diameter_m().is_none()
-            {
-                continue;
-            }
-            for &m in &magnitudes {
-                let (effect, error) = effect_at(class, m, &machine.model, (lo, hi))?;
-                cases.push((class.name().into(), format!("{m}x"), effect, error));
-            }
-        }
+        let mut cases = machine.cases(&classes, &magnitudes)?;
         cases.push((
             "cutting x3 in a band".into(),
             "outside".into(),

@@ -12,11 +12,8 @@
 #[path = "../tests/shop/mod.rs"]
 mod shop;
 
-use chatter_gap::generator::{effect_at, proving_machines};
-use chatter_gap::{
-    DiagnoseOptions, EffectClass, HiddenEffect, Quiet, Recalibration, Scenario, Validation,
-    diagnose,
-};
+use chatter_gap::generator::proving_machines;
+use chatter_gap::{DiagnoseOptions, EffectClass, Quiet, Scenario, Validation, diagnose};
 use std::time::Instant;
 
 fn arg(name: &str) -> Option<String> {
@@ -56,23 +53,7 @@ fn main() -> chatter_gap::Result<()> {
     for &mi in &pick {
         let machine = &machines[mi];
         let (lo, hi) = machine.speed_range_rpm;
-        let mut cases = vec![(
-            "control".to_string(),
-            "control".to_string(),
-            HiddenEffect::ParameterError,
-            Recalibration::default(),
-        )];
-        for &class in &classes {
-            if class == EffectClass::ProcessDamping
-                && machine.model.operation().cutting_diameter_m().is_none()
-            {
-                continue;
-            }
-            for &m in &magnitudes {
-                let (effect, error) = effect_at(class, m, &machine.model, (lo, hi))?;
-                cases.push((class.name().into(), format!("{m}x"), effect, error));
-            }
-        }
+        let cases = machine.cases(&classes, &magnitudes)?;
         for (name, magnitude, effect, error) in cases {
             for seed in 0..seeds {
                 let start = Instant::now();

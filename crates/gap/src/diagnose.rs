@@ -682,16 +682,19 @@ pub fn diagnose(
     })
 }
 
-/// Posterior mean and standard deviation of every physical parameter of a fitted class.
-/// The class's samples in physical parameters.
-fn posterior(f: &Fitted) -> ClassPosterior {
-    let rows: Vec<Vec<(&'static str, f64)>> = f
-        .run
+/// The samples of a fitted class in physical parameters, (name, value) per parameter.
+fn physical_samples(f: &Fitted) -> Vec<Vec<(&'static str, f64)>> {
+    f.run
         .samples
         .samples()
         .iter()
         .map(|t| f.model.physical(t))
-        .collect();
+        .collect()
+}
+
+/// The class's samples in physical parameters.
+fn posterior(f: &Fitted) -> ClassPosterior {
+    let rows = physical_samples(f);
     ClassPosterior {
         parameter_names: rows
             .first()
@@ -704,14 +707,9 @@ fn posterior(f: &Fitted) -> ClassPosterior {
     }
 }
 
+/// Posterior mean and standard deviation of every physical parameter of a fitted class.
 fn summaries(f: &Fitted) -> BTreeMap<String, ParameterSummary> {
-    let rows: Vec<Vec<(&'static str, f64)>> = f
-        .run
-        .samples
-        .samples()
-        .iter()
-        .map(|t| f.model.physical(t))
-        .collect();
+    let rows = physical_samples(f);
     let mut out = BTreeMap::new();
     let Some(first) = rows.first() else {
         return out;

@@ -279,6 +279,36 @@ pub struct ProvingMachine {
     pub speed_range_rpm: (f64, f64),
 }
 
+/// A case of the proving ground: its name, magnitude label ("control" or "2x"), the hidden
+/// effect and the recalibration error of the true machine.
+pub type ProvingCase = (String, String, HiddenEffect, Recalibration);
+
+impl ProvingMachine {
+    /// The control (the nominal model is right) and every class of `classes` at every
+    /// magnitude of `magnitudes` ([`effect_at`]); process damping only where the model has a
+    /// cutting diameter.
+    pub fn cases(&self, classes: &[EffectClass], magnitudes: &[f64]) -> Result<Vec<ProvingCase>> {
+        let mut cases = vec![(
+            "control".to_string(),
+            "control".to_string(),
+            HiddenEffect::ParameterError,
+            Recalibration::default(),
+        )];
+        for &class in classes {
+            if class == EffectClass::ProcessDamping
+                && self.model.operation().cutting_diameter_m().is_none()
+            {
+                continue;
+            }
+            for &m in magnitudes {
+                let (effect, error) = effect_at(class, m, &self.model, self.speed_range_rpm)?;
+                cases.push((class.name().into(), format!("{m}x"), effect, error));
+            }
+        }
+        Ok(cases)
+    }
+}
+
 /// The machines of the proving ground: two-direction milling at 30 % (x 650 Hz, y 720 Hz,
 /// 4 teeth, down), low radial immersion (7 %, 2 teeth, up milling), two modes in one direction
 /// (3 teeth, 50 %), and turning (a feed mode and one at 30 degrees).
