@@ -7,7 +7,7 @@
 //! reuses them for the options that carry the same quantities.
 
 use anyhow::{Result, bail};
-use chatter_dynamics::limits::{Plausible, SPEED_RPM, written};
+use chatter_dynamics::limits::{Plausible, SPEED_RPM, closed, open_closed, written};
 use chatter_dynamics::{ModalModel, Observations, Operation};
 use chatter_stability::monodromy::{Discretization, StepsPerDelay};
 
@@ -71,67 +71,20 @@ pub fn count(flag: &str, value: usize, min: usize, max: usize, what: &str) -> Re
     }
 }
 
-/// A range of plausible values of an option that has no file counterpart.
-pub const fn between(min: f64, max: f64, what: &'static str, unit: &'static str) -> Plausible {
-    Plausible {
-        min,
-        min_included: false,
-        max,
-        max_included: true,
-        what,
-        unit,
-    }
-}
-
 /// Signal length of `chatter simulate`.
-pub const DURATION_S: Plausible = between(0.0, 3600.0, "a signal length", "s");
+pub const DURATION_S: Plausible = open_closed(0.0, 3600.0, "a signal length", "s");
 /// Feed per tooth (milling) or per revolution (turning).
-pub const FEED_MM: Plausible = between(0.0, 10.0, "a feed", "mm");
+pub const FEED_MM: Plausible = open_closed(0.0, 10.0, "a feed", "mm");
 /// RMS or amplitude of a simulated force (zero allowed).
-pub const FORCE_N: Plausible = Plausible {
-    min: 0.0,
-    min_included: true,
-    max: 1e6,
-    max_included: true,
-    what: "a force",
-    unit: "N",
-};
+pub const FORCE_N: Plausible = closed(0.0, 1e6, "a force", "N");
 /// Frequencies of `chatter frf` (zero allowed).
-pub const FRF_HZ: Plausible = Plausible {
-    min: 0.0,
-    min_included: true,
-    max: 1e6,
-    max_included: true,
-    what: "a frequency",
-    unit: "Hz",
-};
+pub const FRF_HZ: Plausible = closed(0.0, 1e6, "a frequency", "Hz");
 /// Speed offset of the Type B bands.
-pub const OFFSET_RPM: Plausible = Plausible {
-    min: 0.0,
-    min_included: true,
-    max: 1e5,
-    max_included: true,
-    what: "a speed offset",
-    unit: "rpm",
-};
+pub const OFFSET_RPM: Plausible = closed(0.0, 1e5, "a speed offset", "rpm");
 /// Depth offset of the Type B bands.
-pub const OFFSET_MM: Plausible = Plausible {
-    min: 0.0,
-    min_included: true,
-    max: 100.0,
-    max_included: true,
-    what: "a depth offset",
-    unit: "mm",
-};
+pub const OFFSET_MM: Plausible = closed(0.0, 100.0, "a depth offset", "mm");
 /// Depths of a `--depths` grid (zero allowed as its first value).
-pub const DEPTH_GRID_MM: Plausible = Plausible {
-    min: 0.0,
-    min_included: true,
-    max: 1000.0,
-    max_included: true,
-    what: "a depth of cut",
-    unit: "mm",
-};
+pub const DEPTH_GRID_MM: Plausible = closed(0.0, 1000.0, "a depth of cut", "mm");
 /// Probability of stability of a tested contour.
 pub const PROBABILITY: Plausible = Plausible {
     min: 0.0,

@@ -79,7 +79,8 @@ impl Plausible {
     }
 }
 
-const fn open_closed(min: f64, max: f64, what: &'static str, unit: &'static str) -> Plausible {
+/// The interval (min, max] of `what` in `unit`.
+pub const fn open_closed(min: f64, max: f64, what: &'static str, unit: &'static str) -> Plausible {
     Plausible {
         min,
         min_included: false,
@@ -90,7 +91,8 @@ const fn open_closed(min: f64, max: f64, what: &'static str, unit: &'static str)
     }
 }
 
-const fn closed(min: f64, max: f64, what: &'static str, unit: &'static str) -> Plausible {
+/// The interval [min, max] of `what` in `unit`.
+pub const fn closed(min: f64, max: f64, what: &'static str, unit: &'static str) -> Plausible {
     Plausible {
         min,
         min_included: true,

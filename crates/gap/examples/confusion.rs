@@ -8,27 +8,17 @@
 //! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1
 //! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --verbose]`
 
+mod common;
+
 use chatter_gap::generator::{proving_machines, true_variant};
 use chatter_gap::predict::inference_solver;
 use chatter_gap::{
     DiagnoseOptions, DiagnosisObserver, EffectClass, HiddenEffect, Recalibration, Scenario,
     Validation, Variant, diagnose, synthesize,
 };
+use common::{arg, list};
 use std::collections::BTreeMap;
 use std::time::Instant;
-
-fn arg(name: &str) -> Option<String> {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1).cloned())
-}
-
-fn list<T: std::str::FromStr>(name: &str, default: Vec<T>) -> Vec<T> {
-    arg(name).map_or(default, |s| {
-        s.split(',').filter_map(|x| x.parse().ok()).collect()
-    })
-}
 
 /// Whether `variant` predicts chatter at a cut (the inference's solver), None on failure.
 fn chatters(variant: &Variant, speed_rpm: f64, depth_m: f64, u: f64) -> Option<bool> {

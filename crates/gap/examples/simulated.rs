@@ -12,22 +12,12 @@
 #[path = "../tests/shop/mod.rs"]
 mod shop;
 
+mod common;
+
 use chatter_gap::generator::proving_machines;
 use chatter_gap::{DiagnoseOptions, EffectClass, Quiet, Scenario, Validation, diagnose};
+use common::{arg, list};
 use std::time::Instant;
-
-fn arg(name: &str) -> Option<String> {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1).cloned())
-}
-
-fn list<T: std::str::FromStr>(name: &str, default: Vec<T>) -> Vec<T> {
-    arg(name).map_or(default, |s| {
-        s.split(',').filter_map(|x| x.parse().ok()).collect()
-    })
-}
 
 fn main() -> chatter_gap::Result<()> {
     let machines = proving_machines()?;
