@@ -43,9 +43,10 @@ use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
 use chatter_stability::frequency_domain::{
-    FrequencyDomain, dominant_pole, mode_poles, unstable_poles,
+    FrequencyDomain, dominant_and_unstable_poles, dominant_pole, mode_poles,
 };
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::multiplier::DominantMultiplier;
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -157,16 +158,15 @@ pub(crate) fn predict_cut(
     let s = inference_solver(&model);
     let mut other_chatter_hz = [f64::NAN; OTHER_ROOTS];
     let (mu, chatter_hz) = if with_frequency && !milling(&model) {
-        let (mu, dominant_hz) = s.chatter_frequency_hz(&model, speed_rpm, depth_m).ok()?;
-        let others = unstable_poles(&model, speed_rpm, depth_m)
-            .ok()?
-            .into_iter()
-            .map(|p| p.lambda.im / (2.0 * PI))
-            .filter(|f| (f - dominant_hz).abs() > 1e-6 * dominant_hz.abs());
-        for (slot, f) in other_chatter_hz.iter_mut().zip(others) {
-            *slot = f;
+        // one Newton pass for the dominant root (FrequencyDomain's multiplier) and the others
+        let (dominant, others) = dominant_and_unstable_poles(&model, speed_rpm, depth_m).ok()?;
+        for (slot, p) in other_chatter_hz.iter_mut().zip(others) {
+            *slot = p.lambda.im / (2.0 * PI);
         }
-        (mu, dominant_hz)
+        (
+            DominantMultiplier::new((dominant.lambda * tau).exp(), tau),
+            dominant.lambda.im / (2.0 * PI),
+        )
     } else {
         let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
         (mu, mu.principal_frequency_hz())

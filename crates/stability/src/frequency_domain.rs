@@ -226,35 +226,46 @@ pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result
         .into_iter()
         .max_by(|a, b| a.re.total_cmp(&b.re))
         .map(ClosedLoopPole::new)
-        .ok_or(StabilityError::NoConvergence {
-            solver: "characteristic-equation Newton",
-            detail: format!("no root found at {speed_rpm} rpm, width {width_m} m"),
-        })
+        .ok_or_else(|| no_root(speed_rpm, width_m))
 }
 
-/// Every distinct unstable (Re lambda > 0) closed-loop pole that the starts of
-/// [`dominant_pole`] reach, by decreasing real part (empty when the cut is stable). Past the
-/// boundary several roots of a chain can be unstable; a nonlinear limit cycle (loss of contact)
-/// may grow from any of them, not always the most unstable (on the gap proving ground's lathe
-/// at 1.4-1.6 |mu| the simulated chatter settles 25-50 Hz from the dominant root, on the root
-/// that crossed the axis first).
-pub fn unstable_poles(
+/// The dominant pole ([`dominant_pole`]) and every other distinct unstable (Re lambda > 0)
+/// closed-loop pole that the same starts reach, by decreasing real part (none when the cut is
+/// stable), from one Newton pass. Past the boundary several roots of a chain can be unstable; a
+/// nonlinear limit cycle (loss of contact) may grow from any of them, not always the most
+/// unstable (on the gap proving ground's lathe at 1.4-1.6 |mu| the simulated chatter settles
+/// 25-50 Hz from the dominant root, on the root that crossed the axis first).
+pub fn dominant_and_unstable_poles(
     model: &ModalModel,
     speed_rpm: f64,
     width_m: f64,
-) -> Result<Vec<ClosedLoopPole>> {
-    let mut roots: Vec<Complex64> = grid_roots(model, speed_rpm, width_m)?
-        .into_iter()
-        .filter(|r| r.re > 0.0)
-        .collect();
+) -> Result<(ClosedLoopPole, Vec<ClosedLoopPole>)> {
+    let mut roots = grid_roots(model, speed_rpm, width_m)?;
     roots.sort_by(|a, b| b.re.total_cmp(&a.re));
-    let mut distinct: Vec<Complex64> = Vec::new();
-    for r in roots {
+    let Some(&dominant) = roots.first() else {
+        return Err(no_root(speed_rpm, width_m));
+    };
+    let mut distinct = vec![dominant];
+    for r in roots.into_iter().filter(|r| r.re > 0.0) {
         if distinct.iter().all(|d| (d - r).norm() > 1e-6 * r.norm()) {
             distinct.push(r);
         }
     }
-    Ok(distinct.into_iter().map(ClosedLoopPole::new).collect())
+    Ok((
+        ClosedLoopPole::new(dominant),
+        distinct[1..]
+            .iter()
+            .map(|&r| ClosedLoopPole::new(r))
+            .collect(),
+    ))
+}
+
+/// The error when no Newton start converges.
+fn no_root(speed_rpm: f64, width_m: f64) -> StabilityError {
+    StabilityError::NoConvergence {
+        solver: "characteristic-equation Newton",
+        detail: format!("no root found at {speed_rpm} rpm, width {width_m} m"),
+    }
 }
 
 /// The roots (upper half plane) that Newton reaches from the starts of [`dominant_pole`].
@@ -340,6 +351,31 @@ mod tests {
             assert!((p.frequency_hz - m.frequency_hz()).abs() < 1e-9 * m.frequency_hz());
             assert!((p.damping_ratio - m.damping_ratio()).abs() < 1e-12);
         }
+    }
+
+    /// The one-pass dominant pole is [`dominant_pole`]'s; the other poles are unstable, slower
+    /// than it and distinct; a stable cut has none and a cut far past the boundary several.
+    #[test]
+    fn unstable_poles_follow_the_dominant_one() {
+        let model = examples::ahmadi_2022_turning();
+        let options = crate::boundary::BoundaryOptions::default();
+        let limit = crate::boundary::limiting_depth(&FrequencyDomain, &model, 7150.0, &options)
+            .unwrap()
+            .depth_m;
+        let (_, none) = dominant_and_unstable_poles(&model, 7150.0, 0.5 * limit).unwrap();
+        assert!(none.is_empty());
+        let mut seen_others = false;
+        for factor in [1.5, 3.0, 6.0] {
+            let b = factor * limit;
+            let (dominant, others) = dominant_and_unstable_poles(&model, 7150.0, b).unwrap();
+            assert_eq!(dominant, dominant_pole(&model, 7150.0, b).unwrap());
+            for p in &others {
+                assert!(p.lambda.re > 0.0 && p.lambda.re <= dominant.lambda.re);
+                assert!((p.lambda - dominant.lambda).norm() > 1e-6 * dominant.lambda.norm());
+            }
+            seen_others |= !others.is_empty();
+        }
+        assert!(seen_others, "no second unstable root up to 6x the limit");
     }
 
     /// Turning with process damping (seed-000 lathe, C = 2e4 N/m, 38 mm workpiece): the poles
