@@ -17,6 +17,7 @@ pub mod monodromy;
 pub mod multiplier;
 pub mod prepared;
 pub mod process_damping;
+pub mod resonance;
 mod root;
 pub mod sensitivity;
 pub mod zero_order;

@@ -185,19 +185,34 @@ impl Discretization {
     ) -> Result<(DominantMultiplier, f64)> {
         let op = self.monodromy(model, speed_rpm, depth_m)?;
         let (mu, vector) = op.dominant_eigenpair_from(start)?;
-        let mu = DominantMultiplier::new(mu, op.period_s);
+        Ok(op.multiplier_and_frequency(model, mu, &vector))
+    }
+}
+
+impl Monodromy {
+    /// The multiplier `mu` with eigenvector `vector` and its chatter frequency: the member of its
+    /// frequency family that [`Self::eigenvector_frequency_hz`] picks within half the lowest to
+    /// twice the highest natural frequency, or the member nearest the dominant mode when the
+    /// eigenfunction is not sampled over the whole delay.
+    pub(crate) fn multiplier_and_frequency(
+        &self,
+        model: &ModalModel,
+        mu: Complex64,
+        vector: &[Complex64],
+    ) -> (DominantMultiplier, f64) {
+        let mu = DominantMultiplier::new(mu, self.period_s);
         let (lo, hi) = model
             .modes()
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
                 (lo.min(m.frequency_hz()), hi.max(m.frequency_hz()))
             });
-        let f = op
-            .eigenvector_frequency_hz(&vector, &mu, (0.5 * lo, 2.0 * hi))
+        let f = self
+            .eigenvector_frequency_hz(vector, &mu, (0.5 * lo, 2.0 * hi))
             .unwrap_or_else(|| {
                 mu.chatter_frequency_near_hz(crate::boundary::dominant_mode_frequency_hz(model))
             });
-        Ok((mu, f))
+        (mu, f)
     }
 }
 
