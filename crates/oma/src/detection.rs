@@ -42,16 +42,20 @@
 //! against everything else in the band, both less the floor, in dB.
 //!
 //! A stationary deterministic line that is not a multiple of f_0 (mains hum, a neighbouring
-//! machine) has a constant amplitude too: give its fundamental in
-//! [`DetectionOptions::interference_hz`]. Period-doubling (flip) chatter of a cutter with an even
+//! machine) has a constant amplitude too. By default ([`Interference::Search`]) a comb of such
+//! lines with a fundamental in 45-65 Hz is searched for (see [`crate::interference`]) and its
+//! member lines are synchronous as well; the comb found is reported in
+//! [`DetectionEvidence::interference`]. Known fundamentals ([`Interference::Known`]) make every
+//! one of their multiples synchronous instead. Period-doubling (flip) chatter of a cutter with an even
 //! number of teeth lies on spindle harmonics and is not detected.
 //!
 //! The chatter frequency is the line's, refined by a parabola through the logarithms of the
 //! three densities around it.
 
 use crate::error::{OmaError, Result};
+use crate::interference::{Interference, InterferenceComb, find_comb, spectral_lines};
 use crate::signals::Signals;
-use crate::spectrum::{Spectrum, power_spectral_density};
+use crate::spectrum::{Spectrum, power_spectral_density, refine_peak_hz};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -94,9 +98,9 @@ pub struct DetectionOptions {
     pub min_burst_variation: f64,
     /// Name of a once-per-revolution channel: excluded from the spectrum, its pulse rate is f_0.
     pub once_per_rev_channel: Option<String>,
-    /// Fundamentals of other known forced combs (Hz), e.g. the mains frequency whose harmonics
-    /// an accelerometer cable picks up; their multiples are synchronous too (default none).
-    pub interference_hz: Vec<f64>,
+    /// Interference combs (mains hum) whose lines are synchronous too: searched for in
+    /// 45-65 Hz by default, given, or none.
+    pub interference: Interference,
 }
 
 impl DetectionOptions {
@@ -111,7 +115,7 @@ impl DetectionOptions {
             max_line_variation: MAX_LINE_VARIATION,
             min_burst_variation: MIN_BURST_VARIATION,
             once_per_rev_channel: None,
-            interference_hz: Vec::new(),
+            interference: Interference::default(),
         }
     }
 }
@@ -153,6 +157,8 @@ pub struct DetectionEvidence {
     /// half: about 1 for a stable resonance driven by random forces (a narrowband Gaussian
     /// process), near 0 for a limit cycle.
     pub line_variation: f64,
+    /// The interference comb found and left out ([`Interference::Search`]), if any.
+    pub interference: Option<InterferenceComb>,
 }
 
 /// Result of [`detect`].
@@ -279,24 +285,43 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let last = ((hi / df).floor() as usize).min(psd.len() - 1);
 
     let f0 = f0_pulse.unwrap_or_else(|| refine_fundamental(&psd, df, f0_nominal, hi, options));
-    if let Some(f) = options
-        .interference_hz
-        .iter()
-        .find(|f| !(f.is_finite() && **f > 0.0))
-    {
-        return Err(invalid(
-            "interference_hz",
-            format!("{f} Hz; expected fundamentals > 0 Hz"),
-        ));
-    }
     let near_multiple = |f: f64, base: f64| {
         let k = (f / base).round().max(1.0);
         (f - k * base).abs() <= 2.5 * df + k * base * HARMONIC_TOLERANCE
     };
-    let synchronous = |i: usize| {
-        let f = i as f64 * df;
-        near_multiple(f, f0) || options.interference_hz.iter().any(|b| near_multiple(f, *b))
+    let (known, comb) = match &options.interference {
+        Interference::Known(bases) => {
+            if let Some(f) = bases.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+                return Err(invalid(
+                    "interference",
+                    format!("{f} Hz; expected fundamentals > 0 Hz"),
+                ));
+            }
+            (bases.clone(), None)
+        }
+        Interference::Search { min_hz, max_hz } => {
+            if !(min_hz.is_finite() && max_hz.is_finite() && *min_hz > 0.0 && max_hz >= min_hz)
+            {
+                return Err(invalid(
+                    "interference",
+                    format!("search range {min_hz} to {max_hz} Hz; expected 0 < min <= max"),
+                ));
+            }
+            let lines = spectral_lines(&psd, df, first, last, |f| near_multiple(f, f0));
+            (Vec::new(), find_comb(&lines, df, (*min_hz, *max_hz), Some(f0)))
+        }
+        Interference::Off => (Vec::new(), None),
     };
+    let comb_lines: &[f64] = comb.as_ref().map_or(&[], |c| &c.lines_hz);
+    let synchronous_bins: Vec<bool> = (0..psd.len())
+        .map(|i| {
+            let f = i as f64 * df;
+            near_multiple(f, f0)
+                || known.iter().any(|b| near_multiple(f, *b))
+                || comb_lines.iter().any(|l| (f - l).abs() <= 2.5 * df)
+        })
+        .collect();
+    let synchronous = |i: usize| synchronous_bins[i];
     let mut floor_values: Vec<f64> = (first..=last)
         .filter(|i| !synchronous(*i))
         .map(|i| psd[i])
@@ -340,7 +365,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let line_to_rest_db = 10.0 * ((e_line + tiny) / (e_sync + e_rest + floor * df)).log10();
     let line_to_forced_db = 10.0 * ((e_line + tiny) / (e_sync + floor * df)).log10();
     let line_to_floor_db = 10.0 * (psd[peak] / floor.max(tiny)).log10();
-    let peak_hz = refine_peak(&psd, peak, df);
+    let peak_hz = refine_peak_hz(&psd, peak, df);
     let line_variation = line_variation(&signals.data, segment, peak);
     let margin = (options.max_line_variation - line_variation)
         .max(line_variation - options.min_burst_variation);
@@ -368,6 +393,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             margin,
             resolution_hz: df,
             line_variation,
+            interference: comb,
         },
         spectrum: Spectrum {
             frequencies_hz: (0..psd.len()).map(|i| i as f64 * df).collect(),
@@ -406,21 +432,6 @@ fn refine_fundamental(psd: &[f64], df: f64, f0: f64, hi: f64, options: &Detectio
         })
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(f0, |(f, _)| f)
-}
-
-/// Peak frequency from a parabola through the logarithms of the densities at bins i-1, i, i+1.
-fn refine_peak(psd: &[f64], i: usize, df: f64) -> f64 {
-    if i == 0 || i + 1 >= psd.len() {
-        return i as f64 * df;
-    }
-    let (a, b, c) = (psd[i - 1].ln(), psd[i].ln(), psd[i + 1].ln());
-    let denom = a - 2.0 * b + c;
-    let shift = if denom.abs() > 0.0 && denom.is_finite() {
-        (0.5 * (a - c) / denom).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    };
-    (i as f64 + shift) * df
 }
 
 /// Coefficient of variation of the line's share of the power over the record's second half
