@@ -14,7 +14,11 @@
 //! Without a once-per-revolution channel the nominal f_0 is refined within
 //! +-[`DetectionOptions::speed_tolerance`] to the value that maximizes sum_k ln S(k f_0) over the
 //! harmonics in the band (a logarithmic comb, so a single strong chatter line cannot pull the
-//! comb onto itself); with one, f_0 is the pulse rate.
+//! comb onto itself); with one, f_0 is the pulse rate. When the speed is unknown
+//! ([`Fundamental::Search`], e.g. a sound clip whose cutting conditions were not recorded), f_0
+//! is the fundamental of the record's harmonic comb in the given range
+//! ([`crate::interference::harmonic_fundamental`]: the most lines at its first 12 multiples, the
+//! lowest of equally good submultiples); a record without such a comb is an error.
 //!
 //! # Criterion
 //! A bin is synchronous when it lies within 2.5 df + k f_0 [`HARMONIC_TOLERANCE`] of a multiple
@@ -53,7 +57,10 @@
 //! three densities around it.
 
 use crate::error::{OmaError, Result};
-use crate::interference::{Interference, InterferenceComb, find_comb, spectral_lines};
+use crate::interference::{
+    Interference, InterferenceComb, LOW_HARMONICS, MIN_LOW_MEMBERS, find_comb,
+    harmonic_fundamental, spectral_lines,
+};
 use crate::signals::Signals;
 use crate::spectrum::{Spectrum, power_spectral_density, refine_peak_hz};
 use rayon::prelude::*;
@@ -75,15 +82,45 @@ pub const HARMONIC_TOLERANCE: f64 = 5e-4;
 /// Default relative search range of the fundamental around its nominal value.
 pub const SPEED_TOLERANCE: f64 = 0.005;
 
+/// Default range of the spindle frequency searched when it is unknown (Hz): 600 to 30 000 rpm.
+pub const SPINDLE_RANGE_HZ: (f64, f64) = (10.0, 500.0);
+
+/// Where the fundamental f_0 comes from (a once-per-revolution channel overrides both).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fundamental {
+    /// The spindle rotation frequency rpm / 60 (Hz), refined within
+    /// [`DetectionOptions::speed_tolerance`].
+    Nominal(f64),
+    /// Unknown speed: the fundamental of the record's harmonic comb in `min_hz` to `max_hz`
+    /// (default [`SPINDLE_RANGE_HZ`]).
+    Search {
+        /// Lowest fundamental (Hz).
+        min_hz: f64,
+        /// Highest fundamental (Hz).
+        max_hz: f64,
+    },
+}
+
+impl Fundamental {
+    /// The lowest fundamental it can be (Hz): the scale of the default resolution and band.
+    fn lowest_hz(self) -> f64 {
+        match self {
+            Self::Nominal(f) => f,
+            Self::Search { min_hz, .. } => min_hz,
+        }
+    }
+}
+
 /// Options of [`detect`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DetectionOptions {
-    /// Nominal fundamental (Hz): the spindle rotation frequency, rpm / 60.
-    pub fundamental_hz: f64,
-    /// Finest bin width wanted (Hz); default `None`: f_0 / 10, at most 2 Hz, with at least 8
-    /// segments in the record.
+    /// The fundamental: nominal (the spindle rotation frequency) or searched.
+    pub fundamental: Fundamental,
+    /// Finest bin width wanted (Hz); default `None`: f_0 / 10 (the lowest f_0 searched), at
+    /// most 2 Hz, with at least 8 segments in the record.
     pub resolution_hz: Option<f64>,
-    /// Lowest frequency searched (Hz); default `None`: f_0 / 2.
+    /// Lowest frequency searched (Hz); default `None`: f_0 / 2 (the lowest f_0 searched).
     pub min_frequency_hz: Option<f64>,
     /// Highest frequency searched (Hz); default `None`: 0.45 times the sample rate.
     pub max_frequency_hz: Option<f64>,
@@ -104,10 +141,23 @@ pub struct DetectionOptions {
 }
 
 impl DetectionOptions {
-    /// Options with the documented defaults for fundamental `fundamental_hz`.
+    /// Options with the documented defaults for the nominal fundamental `fundamental_hz`.
     pub fn new(fundamental_hz: f64) -> Self {
+        Self::with_fundamental(Fundamental::Nominal(fundamental_hz))
+    }
+
+    /// Options with the documented defaults for an unknown speed: the fundamental is searched
+    /// over [`SPINDLE_RANGE_HZ`].
+    pub fn unknown_speed() -> Self {
+        Self::with_fundamental(Fundamental::Search {
+            min_hz: SPINDLE_RANGE_HZ.0,
+            max_hz: SPINDLE_RANGE_HZ.1,
+        })
+    }
+
+    fn with_fundamental(fundamental: Fundamental) -> Self {
         Self {
-            fundamental_hz,
+            fundamental,
             resolution_hz: None,
             min_frequency_hz: None,
             max_frequency_hz: None,
@@ -186,11 +236,23 @@ fn invalid(field: &'static str, message: String) -> OmaError {
 pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection> {
     let fs = signals.sample_rate_hz;
     let nyquist = fs / 2.0;
-    let f0_nominal = options.fundamental_hz;
-    if !(f0_nominal.is_finite() && f0_nominal > 0.0 && f0_nominal < nyquist) {
+    let f0_lowest = options.fundamental.lowest_hz();
+    let f0_highest = match options.fundamental {
+        Fundamental::Nominal(f) => f,
+        Fundamental::Search { max_hz, .. } => max_hz,
+    };
+    if !(f0_lowest.is_finite()
+        && f0_highest.is_finite()
+        && f0_lowest > 0.0
+        && f0_highest >= f0_lowest
+        && f0_highest < nyquist)
+    {
         return Err(invalid(
             "fundamental_hz",
-            format!("{f0_nominal} Hz; expected a frequency in (0, {nyquist}) Hz"),
+            format!(
+                "{f0_lowest} to {f0_highest} Hz; expected a frequency (or range) in (0, \
+                 {nyquist}) Hz"
+            ),
         ));
     }
     if !(options.speed_tolerance.is_finite() && (0.0..0.2).contains(&options.speed_tolerance)) {
@@ -237,7 +299,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             ));
         }
         Some(r) => r,
-        None => (f0_nominal / 10.0).min(2.0),
+        None => (f0_lowest / 10.0).min(2.0),
     };
     // segment: a power of two with df <= resolution, at most an eighth of the record (at
     // least 64 samples)
@@ -273,7 +335,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             *a += b;
         }
     }
-    let lo = options.min_frequency_hz.unwrap_or(f0_nominal / 2.0);
+    let lo = options.min_frequency_hz.unwrap_or(f0_lowest / 2.0);
     let hi = options.max_frequency_hz.unwrap_or(0.45 * fs).min(nyquist);
     if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo + 8.0 * df) {
         return Err(invalid(
@@ -284,7 +346,22 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let first = ((lo / df).ceil() as usize).max(1);
     let last = ((hi / df).floor() as usize).min(psd.len() - 1);
 
-    let f0 = f0_pulse.unwrap_or_else(|| refine_fundamental(&psd, df, f0_nominal, hi, options));
+    let f0 = match (f0_pulse, options.fundamental) {
+        (Some(f), _) => f,
+        (None, Fundamental::Nominal(f)) => refine_fundamental(&psd, df, f, hi, options),
+        (None, Fundamental::Search { min_hz, max_hz }) => {
+            let lines = spectral_lines(&psd, df, first, last, |_| false);
+            harmonic_fundamental(&lines, df, (min_hz, max_hz))
+                .ok_or_else(|| {
+                    OmaError::NoPole(format!(
+                        "no harmonic comb with a fundamental in {min_hz}-{max_hz} Hz (lines at \
+                         {MIN_LOW_MEMBERS} of its first {LOW_HARMONICS} multiples): the \
+                         spindle frequency cannot be estimated; give the speed"
+                    ))
+                })?
+                .fundamental_hz
+        }
+    };
     let near_multiple = |f: f64, base: f64| {
         let k = (f / base).round().max(1.0);
         (f - k * base).abs() <= 2.5 * df + k * base * HARMONIC_TOLERANCE

@@ -20,8 +20,17 @@
 //!    refined by least squares through the origin over all its members (f_m = sum k f_k / sum
 //!    k^2), twice.
 //! 3. **Comb**: found when at least [`MIN_LOW_MEMBERS`] of the first [`LOW_HARMONICS`]
-//!    multiples are members, and the members are not all on the multiples of f_0 / q for
-//!    q = 2, 3, 4 (that comb is the spindle's own: period-doubling or period-q chatter).
+//!    multiples are members, and
+//!    - it is not part of a finer comb: for no j = 2 to [`MAX_FINER_DIVISOR`] are there lines
+//!      at the multiples k f_m / j with k not a multiple of j (within the same tolerance) at least
+//!      half as many as the members. Mains hum has nothing between its multiples; a record with a
+//!      motion periodic over several revolutions has lines at all multiples of f_0 / q, and every
+//!      comb in 45-65 Hz that is a multiple of f_0 / q is a sub-comb of it (a simulated chatter
+//!      cut at 7000 rpm, its lines on the multiples of f_0 / 7 = 16.7 Hz, showed a 70-line
+//!      "comb" at 50 Hz = 3 f_0 / 7 before this rule);
+//!    - the members are not all on the multiples of f_0 / q for q = 2, 3, 4 (that comb is the
+//!      spindle's own: period-doubling or period-q chatter, whose in-between multiples are
+//!      spindle harmonics and hence not among the lines).
 //!
 //! Only the members are left out of the chatter search, each over the same +-2.5 df band as a
 //! forced harmonic; a line near an empty multiple of f_m stays (a chatter line that happens to
@@ -56,6 +65,8 @@ pub const MEMBER_TOLERANCE_BINS: f64 = 0.4;
 pub const LOW_HARMONICS: usize = 12;
 /// Members needed among the first [`LOW_HARMONICS`] multiples.
 pub const MIN_LOW_MEMBERS: usize = 4;
+/// Largest j for which a comb is checked for being part of the finer comb f_m / j.
+pub const MAX_FINER_DIVISOR: usize = 8;
 
 /// Where interference fundamentals come from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -156,8 +167,63 @@ fn least_squares_fundamental(members: &[(usize, f64)]) -> f64 {
 pub fn find_comb(
     lines_hz: &[f64],
     df: f64,
-    (min_hz, max_hz): (f64, f64),
+    range_hz: (f64, f64),
     spindle_hz: Option<f64>,
+) -> Option<InterferenceComb> {
+    let comb = best_comb(lines_hz, df, range_hz)?;
+    let tolerance = MEMBER_TOLERANCE_BINS * df;
+    let part_of_finer_comb = (2..=MAX_FINER_DIVISOR).any(|j| {
+        let base = comb.fundamental_hz / j as f64;
+        let between = lines_hz
+            .iter()
+            .filter(|&&f| {
+                let k = (f / base).round();
+                k >= 1.0 && (k as usize) % j != 0 && (f - k * base).abs() <= tolerance
+            })
+            .count();
+        2 * between >= comb.lines_hz.len()
+    });
+    if part_of_finer_comb {
+        return None;
+    }
+    let subharmonic_family = spindle_hz.is_some_and(|f0| {
+        (2..=4).any(|q| {
+            let base = f0 / q as f64;
+            comb.lines_hz
+                .iter()
+                .all(|f| (f - (f / base).round() * base).abs() <= tolerance)
+        })
+    });
+    (!subharmonic_family).then_some(comb)
+}
+
+/// The fundamental of the harmonic comb of a record whose spindle speed is unknown: the comb
+/// with a fundamental in `range_hz` found as in [`find_comb`] (steps 1-3 of the
+/// [criterion](self#criterion), with no line left out beforehand), then, since every multiple
+/// q f_0 of a complete comb's fundamental explains its first multiples as well, the lowest
+/// f / q (q = 2 to 4, within the range) whose comb has at least as many members among its first
+/// [`LOW_HARMONICS`] multiples.
+pub fn harmonic_fundamental(
+    lines_hz: &[f64],
+    df: f64,
+    range_hz: (f64, f64),
+) -> Option<InterferenceComb> {
+    let best = best_comb(lines_hz, df, range_hz)?;
+    (2..=4)
+        .rev()
+        .map(|q| best.fundamental_hz / q as f64)
+        .filter(|f| *f >= range_hz.0)
+        .filter_map(|f| refined_comb(lines_hz, df, f))
+        .find(|c| c.low_members >= best.low_members)
+        .or(Some(best))
+}
+
+/// The comb with the most members among the first [`LOW_HARMONICS`] multiples of a fundamental
+/// in `range_hz`, refined, with at least [`MIN_LOW_MEMBERS`] of them.
+fn best_comb(
+    lines_hz: &[f64],
+    df: f64,
+    (min_hz, max_hz): (f64, f64),
 ) -> Option<InterferenceComb> {
     if !(min_hz > 0.0 && max_hz >= min_hz && df > 0.0) {
         return None;
@@ -180,30 +246,30 @@ pub fn find_comb(
             .sum();
         (low.len(), spread)
     };
-    let (mut f_m, (best, _)) = (0..=count)
+    let (f_m, (best, _)) = (0..=count)
         .map(|c| (min_hz + c as f64 * step).min(max_hz))
         .map(|f| (f, score(f)))
         .max_by(|a, b| a.1.0.cmp(&b.1.0).then(b.1.1.total_cmp(&a.1.1)))?;
     if best < MIN_LOW_MEMBERS {
         return None;
     }
+    refined_comb(lines_hz, df, f_m)
+}
+
+/// The comb of `lines_hz` around the fundamental `f_m`, refined by least squares over its
+/// members (twice), if it keeps at least [`MIN_LOW_MEMBERS`] among its first multiples.
+fn refined_comb(lines_hz: &[f64], df: f64, mut f_m: f64) -> Option<InterferenceComb> {
+    let tolerance = MEMBER_TOLERANCE_BINS * df;
     for _ in 0..2 {
         let m = members(lines_hz, f_m, tolerance);
+        if m.is_empty() {
+            return None;
+        }
         f_m = least_squares_fundamental(&m);
     }
     let m = members(lines_hz, f_m, tolerance);
     let low_members = m.iter().filter(|(k, _)| *k <= LOW_HARMONICS).count();
     if low_members < MIN_LOW_MEMBERS {
-        return None;
-    }
-    let subharmonic_family = spindle_hz.is_some_and(|f0| {
-        (2..=4).any(|q| {
-            let base = f0 / q as f64;
-            m.iter()
-                .all(|(_, f)| (f - (f / base).round() * base).abs() <= tolerance)
-        })
-    });
-    if subharmonic_family {
         return None;
     }
     Some(InterferenceComb {
@@ -251,5 +317,10 @@ mod tests {
         let lines = spectral_lines(&psd, df, 10, 1900, |_| false);
         assert!(find_comb(&lines, df, MAINS_RANGE_HZ, Some(100.0)).is_none());
         assert!(find_comb(&lines, df, MAINS_RANGE_HZ, Some(83.0)).is_some());
+        // lines at every multiple of 50 / 3 Hz: the 50 Hz comb is part of a finer one
+        let fine: Vec<f64> = (1..=40).map(|k| 50.0 / 3.0 * k as f64).collect();
+        let psd = density(2000, &fine, df);
+        let lines = spectral_lines(&psd, df, 10, 1900, |_| false);
+        assert!(find_comb(&lines, df, MAINS_RANGE_HZ, None).is_none());
     }
 }
