@@ -346,11 +346,52 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let first = ((lo / df).ceil() as usize).max(1);
     let last = ((hi / df).floor() as usize).min(psd.len() - 1);
 
+    let near_multiple = |f: f64, base: f64| {
+        let k = (f / base).round().max(1.0);
+        (f - k * base).abs() <= 2.5 * df + k * base * HARMONIC_TOLERANCE
+    };
+    let known: &[f64] = match &options.interference {
+        Interference::Known(bases) => {
+            if let Some(f) = bases.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+                return Err(invalid(
+                    "interference",
+                    format!("{f} Hz; expected fundamentals > 0 Hz"),
+                ));
+            }
+            bases
+        }
+        Interference::Search { min_hz, max_hz } => {
+            if !(min_hz.is_finite() && max_hz.is_finite() && *min_hz > 0.0 && max_hz >= min_hz)
+            {
+                return Err(invalid(
+                    "interference",
+                    format!("search range {min_hz} to {max_hz} Hz; expected 0 < min <= max"),
+                ));
+            }
+            &[]
+        }
+        Interference::Off => &[],
+    };
+    let interference_search = |spindle_hz: Option<f64>| match options.interference {
+        Interference::Search { min_hz, max_hz } => {
+            let lines = spectral_lines(&psd, df, first, last, |f| {
+                spindle_hz.is_some_and(|f0| near_multiple(f, f0))
+            });
+            find_comb(&lines, df, (min_hz, max_hz), spindle_hz)
+        }
+        _ => None,
+    };
     let f0 = match (f0_pulse, options.fundamental) {
         (Some(f), _) => f,
         (None, Fundamental::Nominal(f)) => refine_fundamental(&psd, df, f, hi, options),
         (None, Fundamental::Search { min_hz, max_hz }) => {
-            let lines = spectral_lines(&psd, df, first, last, |_| false);
+            // interference first, so that a mains comb is not taken for the spindle's
+            let hum = interference_search(None);
+            let hum_lines: &[f64] = hum.as_ref().map_or(&[], |c| &c.lines_hz);
+            let lines = spectral_lines(&psd, df, first, last, |f| {
+                known.iter().any(|b| near_multiple(f, *b))
+                    || hum_lines.iter().any(|l| (f - l).abs() <= 2.5 * df)
+            });
             harmonic_fundamental(&lines, df, (min_hz, max_hz))
                 .ok_or_else(|| {
                     OmaError::NoPole(format!(
@@ -362,33 +403,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
                 .fundamental_hz
         }
     };
-    let near_multiple = |f: f64, base: f64| {
-        let k = (f / base).round().max(1.0);
-        (f - k * base).abs() <= 2.5 * df + k * base * HARMONIC_TOLERANCE
-    };
-    let (known, comb) = match &options.interference {
-        Interference::Known(bases) => {
-            if let Some(f) = bases.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-                return Err(invalid(
-                    "interference",
-                    format!("{f} Hz; expected fundamentals > 0 Hz"),
-                ));
-            }
-            (bases.clone(), None)
-        }
-        Interference::Search { min_hz, max_hz } => {
-            if !(min_hz.is_finite() && max_hz.is_finite() && *min_hz > 0.0 && max_hz >= min_hz)
-            {
-                return Err(invalid(
-                    "interference",
-                    format!("search range {min_hz} to {max_hz} Hz; expected 0 < min <= max"),
-                ));
-            }
-            let lines = spectral_lines(&psd, df, first, last, |f| near_multiple(f, f0));
-            (Vec::new(), find_comb(&lines, df, (*min_hz, *max_hz), Some(f0)))
-        }
-        Interference::Off => (Vec::new(), None),
-    };
+    let comb = interference_search(Some(f0));
     let comb_lines: &[f64] = comb.as_ref().map_or(&[], |c| &c.lines_hz);
     let synchronous_bins: Vec<bool> = (0..psd.len())
         .map(|i| {

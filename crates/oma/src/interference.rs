@@ -28,6 +28,8 @@
 //!      comb in 45-65 Hz that is a multiple of f_0 / q is a sub-comb of it (a simulated chatter
 //!      cut at 7000 rpm, its lines on the multiples of f_0 / 7 = 16.7 Hz, showed a 70-line
 //!      "comb" at 50 Hz = 3 f_0 / 7 before this rule);
+//!    - the harmonic numbers of its members have no common divisor j > 1 (else they are the
+//!      comb of j f_m: a spindle comb at 100 Hz has members at the even multiples of 50 Hz);
 //!    - the members are not all on the multiples of f_0 / q for q = 2, 3, 4 (that comb is the
 //!      spindle's own: period-doubling or period-q chatter, whose in-between multiples are
 //!      spindle harmonics and hence not among the lines).
@@ -152,6 +154,15 @@ fn members(lines_hz: &[f64], f_m: f64, tolerance_hz: f64) -> Vec<(usize, f64)> {
         .collect()
 }
 
+/// Greatest common divisor (Euclid); gcd(0, n) = n.
+fn greatest_common_divisor(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        greatest_common_divisor(b, a % b)
+    }
+}
+
 /// Least-squares fundamental through the origin of harmonic numbers and frequencies.
 fn least_squares_fundamental(members: &[(usize, f64)]) -> f64 {
     let (num, den) = members.iter().fold((0.0, 0.0), |(n, d), &(k, f)| {
@@ -171,21 +182,10 @@ pub fn find_comb(
     spindle_hz: Option<f64>,
 ) -> Option<InterferenceComb> {
     let comb = best_comb(lines_hz, df, range_hz)?;
-    let tolerance = MEMBER_TOLERANCE_BINS * df;
-    let part_of_finer_comb = (2..=MAX_FINER_DIVISOR).any(|j| {
-        let base = comb.fundamental_hz / j as f64;
-        let between = lines_hz
-            .iter()
-            .filter(|&&f| {
-                let k = (f / base).round();
-                k >= 1.0 && (k as usize) % j != 0 && (f - k * base).abs() <= tolerance
-            })
-            .count();
-        2 * between >= comb.lines_hz.len()
-    });
-    if part_of_finer_comb {
+    if finer_divisor(lines_hz, df, &comb).is_some() || common_divisor(&comb) != 1 {
         return None;
     }
+    let tolerance = MEMBER_TOLERANCE_BINS * df;
     let subharmonic_family = spindle_hz.is_some_and(|f0| {
         (2..=4).any(|q| {
             let base = f0 / q as f64;
@@ -198,24 +198,56 @@ pub fn find_comb(
 }
 
 /// The fundamental of the harmonic comb of a record whose spindle speed is unknown: the comb
-/// with a fundamental in `range_hz` found as in [`find_comb`] (steps 1-3 of the
-/// [criterion](self#criterion), with no line left out beforehand), then, since every multiple
-/// q f_0 of a complete comb's fundamental explains its first multiples as well, the lowest
-/// f / q (q = 2 to 4, within the range) whose comb has at least as many members among its first
-/// [`LOW_HARMONICS`] multiples.
+/// with the most members among its first [`LOW_HARMONICS`] multiples for a fundamental in
+/// `range_hz` (steps 1-2 of the [criterion](self#criterion), with no line left out beforehand),
+/// then made the comb of its true fundamental by the same two rules as an interference comb:
+/// multiplied by the common divisor of its members' harmonic numbers (a comb found at f_0 / 3
+/// has members only at multiples of 3), then divided by the largest j <= [`MAX_FINER_DIVISOR`]
+/// with lines between its multiples at least half as many as its members (a milling record's
+/// tooth-passing comb, with the spindle harmonics between its multiples), as long as it stays
+/// in the range. Each step refines the comb by least squares over its members.
 pub fn harmonic_fundamental(
     lines_hz: &[f64],
     df: f64,
     range_hz: (f64, f64),
 ) -> Option<InterferenceComb> {
     let best = best_comb(lines_hz, df, range_hz)?;
-    (2..=4)
-        .rev()
-        .map(|q| best.fundamental_hz / q as f64)
-        .filter(|f| *f >= range_hz.0)
-        .filter_map(|f| refined_comb(lines_hz, df, f))
-        .find(|c| c.low_members >= best.low_members)
-        .or(Some(best))
+    let divisor = common_divisor(&best);
+    let coarse = if divisor > 1 {
+        refined_comb(lines_hz, df, best.fundamental_hz * divisor as f64).unwrap_or(best)
+    } else {
+        best
+    };
+    match finer_divisor(lines_hz, df, &coarse) {
+        Some(j) if coarse.fundamental_hz / j as f64 >= range_hz.0 => {
+            refined_comb(lines_hz, df, coarse.fundamental_hz / j as f64).or(Some(coarse))
+        }
+        _ => Some(coarse),
+    }
+}
+
+/// The largest j in 2..=[`MAX_FINER_DIVISOR`] for which `lines_hz` holds lines at the multiples
+/// k f_m / j with k not a multiple of j at least half as many as the comb's members.
+fn finer_divisor(lines_hz: &[f64], df: f64, comb: &InterferenceComb) -> Option<usize> {
+    let tolerance = MEMBER_TOLERANCE_BINS * df;
+    (2..=MAX_FINER_DIVISOR).rev().find(|&j| {
+        let base = comb.fundamental_hz / j as f64;
+        let between = lines_hz
+            .iter()
+            .filter(|&&f| {
+                let k = (f / base).round();
+                k >= 1.0 && (k as usize) % j != 0 && (f - k * base).abs() <= tolerance
+            })
+            .count();
+        2 * between >= comb.lines_hz.len()
+    })
+}
+
+/// The greatest common divisor of the harmonic numbers of a comb's members.
+fn common_divisor(comb: &InterferenceComb) -> usize {
+    comb.lines_hz.iter().fold(0, |g, f| {
+        greatest_common_divisor(g, (f / comb.fundamental_hz).round() as usize)
+    })
 }
 
 /// The comb with the most members among the first [`LOW_HARMONICS`] multiples of a fundamental
@@ -322,5 +354,13 @@ mod tests {
         let psd = density(2000, &fine, df);
         let lines = spectral_lines(&psd, df, 10, 1900, |_| false);
         assert!(find_comb(&lines, df, MAINS_RANGE_HZ, None).is_none());
+        // a 100 Hz comb has members only at the even multiples of 50 Hz
+        let coarse: Vec<f64> = (1..=12).map(|k| 100.0 * k as f64).collect();
+        let psd = density(2000, &coarse, df);
+        let lines = spectral_lines(&psd, df, 10, 1900, |_| false);
+        assert!(find_comb(&lines, df, MAINS_RANGE_HZ, None).is_none());
+        // ... whose fundamental is 100 Hz, not 50 or 33.3 Hz
+        let c = harmonic_fundamental(&lines, df, (10.0, 500.0)).unwrap();
+        assert!((c.fundamental_hz - 100.0).abs() < 1e-9, "{c:?}");
     }
 }

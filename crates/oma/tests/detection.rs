@@ -245,7 +245,7 @@ fn simulated_turning_lobe_diagram() {
 }
 
 /// Which multiples of an interference fundamental a built record carries.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 enum Comb {
     /// Multiples 1 to 40.
     All,
@@ -386,6 +386,50 @@ fn mains_combs_are_found_and_left_out() {
         assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
         assert!(close(d.chatter_hz.unwrap(), 1300.8, &d), "{:?}", d.evidence);
     }
+}
+
+/// The speed unknown (`DetectionOptions::unknown_speed`): on the built records, with and without
+/// the self-excited line and a 50.02 Hz mains comb, the fundamental estimated from the harmonic
+/// comb is the 80 Hz the records were built with (within 0.1 %), the mains comb is still found,
+/// and the verdicts are those of the records (the same as with the speed given). A record of
+/// noise has no comb: a clear error.
+#[test]
+fn unknown_speed_is_estimated_from_the_harmonic_comb() {
+    let options = DetectionOptions::unknown_speed();
+    for seed in 0..3 {
+        for mains in [None, Some((50.02, Comb::All))] {
+            for chatter_hz in [None, Some(1234.5)] {
+                let d = detect(&built_record(chatter_hz, mains, seed), &options).unwrap();
+                let e = &d.evidence;
+                eprintln!(
+                    "seed {seed}, mains {mains:?}, chatter {chatter_hz:?}: f0 {:.4} Hz, {:?} \
+                     at {:?} Hz, comb {:?}",
+                    e.fundamental_hz,
+                    d.verdict,
+                    d.chatter_hz,
+                    e.interference.as_ref().map(|c| c.fundamental_hz)
+                );
+                assert!((e.fundamental_hz / 80.0 - 1.0).abs() < 1e-3, "{e:?}");
+                let comb = e.interference.as_ref().map(|c| c.fundamental_hz);
+                assert_eq!(comb.is_some(), mains.is_some(), "{e:?}");
+                assert!(comb.is_none_or(|f| (f - 50.02).abs() < 0.01), "{e:?}");
+                match chatter_hz {
+                    Some(f) => {
+                        assert_eq!(d.verdict, Verdict::Chatter, "{e:?}");
+                        assert!((d.chatter_hz.unwrap() - f).abs() <= e.resolution_hz);
+                    }
+                    None => assert_eq!(d.verdict, Verdict::Stable, "{e:?}"),
+                }
+            }
+        }
+    }
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let x: Vec<f64> = (0..40_000)
+        .map(|_| StandardNormal.sample(&mut rng))
+        .collect();
+    let s = Signals::new(vec!["a".into()], 10_000.0, vec![x]).unwrap();
+    let e = detect(&s, &options).unwrap_err().to_string();
+    assert!(e.contains("no harmonic comb"), "{e}");
 }
 
 /// Out of scope and bad input: pure noise is never chatter; a fundamental above the Nyquist
