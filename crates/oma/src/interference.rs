@@ -22,14 +22,16 @@
 //! 3. **Comb**: found when at least [`MIN_LOW_MEMBERS`] of the first [`LOW_HARMONICS`]
 //!    multiples are members, and
 //!    - it is not part of a finer comb: for no j = 2 to [`MAX_FINER_DIVISOR`] are there lines
-//!      at the multiples k f_m / j with k not a multiple of j (within the same tolerance) at least
-//!      half as many as the members. Mains hum has nothing between its multiples; a record with a
+//!      at [`MIN_LOW_MEMBERS`] or more of the multiples k f_m / j, k <= 12 j, with k not a
+//!      multiple of j (within the same tolerance): the evidence a comb needs, between its
+//!      multiples. Mains hum has nothing between its multiples; a record with a
 //!      motion periodic over several revolutions has lines at all multiples of f_0 / q, and every
 //!      comb in 45-65 Hz that is a multiple of f_0 / q is a sub-comb of it (a simulated chatter
 //!      cut at 7000 rpm, its lines on the multiples of f_0 / 7 = 16.7 Hz, showed a 70-line
 //!      "comb" at 50 Hz = 3 f_0 / 7 before this rule);
-//!    - the harmonic numbers of its members have no common divisor j > 1 (else they are the
-//!      comb of j f_m: a spindle comb at 100 Hz has members at the even multiples of 50 Hz);
+//!    - the harmonic numbers of its members among the first 12 multiples have no common
+//!      divisor j > 1 (else they are the comb of j f_m: a spindle comb at 100 Hz has members at
+//!      the even multiples of 50 Hz);
 //!    - the members are not all on the multiples of f_0 / q for q = 2, 3, 4 (that comb is the
 //!      spindle's own: period-doubling or period-q chatter, whose in-between multiples are
 //!      spindle harmonics and hence not among the lines).
@@ -203,9 +205,9 @@ pub fn find_comb(
 /// then made the comb of its true fundamental by the same two rules as an interference comb:
 /// multiplied by the common divisor of its members' harmonic numbers (a comb found at f_0 / 3
 /// has members only at multiples of 3), then divided by the largest j <= [`MAX_FINER_DIVISOR`]
-/// with lines between its multiples at least half as many as its members (a milling record's
-/// tooth-passing comb, with the spindle harmonics between its multiples), as long as it stays
-/// in the range. Each step refines the comb by least squares over its members.
+/// with lines at [`MIN_LOW_MEMBERS`] of the low multiples of f / j between its own (a milling
+/// record's tooth-passing comb, with the spindle harmonics between its multiples), as long as it
+/// stays in the range. Each step refines the comb by least squares over its members.
 pub fn harmonic_fundamental(
     lines_hz: &[f64],
     df: f64,
@@ -226,8 +228,9 @@ pub fn harmonic_fundamental(
     }
 }
 
-/// The largest j in 2..=[`MAX_FINER_DIVISOR`] for which `lines_hz` holds lines at the multiples
-/// k f_m / j with k not a multiple of j at least half as many as the comb's members.
+/// The largest j in 2..=[`MAX_FINER_DIVISOR`] for which `lines_hz` holds lines at
+/// [`MIN_LOW_MEMBERS`] or more of the multiples k f_m / j, k <= [`LOW_HARMONICS`] j, with k not a
+/// multiple of j: the low-harmonic evidence a comb needs, between the comb's own multiples.
 fn finer_divisor(lines_hz: &[f64], df: f64, comb: &InterferenceComb) -> Option<usize> {
     let tolerance = MEMBER_TOLERANCE_BINS * df;
     (2..=MAX_FINER_DIVISOR).rev().find(|&j| {
@@ -236,18 +239,24 @@ fn finer_divisor(lines_hz: &[f64], df: f64, comb: &InterferenceComb) -> Option<u
             .iter()
             .filter(|&&f| {
                 let k = (f / base).round();
-                k >= 1.0 && (k as usize) % j != 0 && (f - k * base).abs() <= tolerance
+                k >= 1.0
+                    && (k as usize) <= LOW_HARMONICS * j
+                    && (k as usize) % j != 0
+                    && (f - k * base).abs() <= tolerance
             })
             .count();
-        2 * between >= comb.lines_hz.len()
+        between >= MIN_LOW_MEMBERS
     })
 }
 
-/// The greatest common divisor of the harmonic numbers of a comb's members.
+/// The greatest common divisor of the harmonic numbers of a comb's members among its first
+/// [`LOW_HARMONICS`] multiples (a chance member far up the band does not count).
 fn common_divisor(comb: &InterferenceComb) -> usize {
-    comb.lines_hz.iter().fold(0, |g, f| {
-        greatest_common_divisor(g, (f / comb.fundamental_hz).round() as usize)
-    })
+    comb.lines_hz
+        .iter()
+        .map(|f| (f / comb.fundamental_hz).round() as usize)
+        .filter(|k| *k <= LOW_HARMONICS)
+        .fold(0, greatest_common_divisor)
 }
 
 /// The comb with the most members among the first [`LOW_HARMONICS`] multiples of a fundamental
