@@ -1054,6 +1054,49 @@ fn oma_refuses_the_real_chatter_record() {
     assert!(off(f, 50.0) > 1.0 && off(f, 5000.0 / 60.0) > 1.0, "{pole}");
 }
 
+/// `chatter detect --estimate-speed` on the no-chatter sound clip of the shared data folder
+/// (cutting conditions not recorded): the spindle speed is estimated from the clip's harmonic
+/// comb at 5496 rpm (91.6 Hz; its lines 91.5, 366.7, 732.8, 1007.4, 1099.5 Hz are multiples 1, 4,
+/// 8, 11, 12, checked with a separate Welch spectrum), written as the cut's `speed_rpm` and named
+/// in its note, and the cut is stable, as labelled. Skipped with a message when the data are
+/// absent.
+#[test]
+fn detect_estimates_the_speed_of_a_sound_clip() {
+    let clip = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/real/milling_chatter_record/metalcutting_nochatter8058.mp3");
+    if !clip.exists() {
+        eprintln!("skipped: {} is absent", clip.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obs = dir.path().join("obs.json");
+    std::fs::write(
+        &obs,
+        format!(
+            r#"{{ "signals": [ {{ "file": {:?}, "speed_rpm": 1000, "depth_mm": 1,
+                 "quantity": "sound" }} ] }}"#,
+            clip.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let out = succeed(chatter().args([
+        "detect",
+        "--estimate-speed",
+        "--observations",
+        obs.to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cut = &json["cuts"][0];
+    assert_eq!(cut["stable"], true, "{cut}");
+    let rpm = cut["speed_rpm"].as_f64().unwrap();
+    assert!((rpm - 5496.0).abs() < 6.0, "{cut}");
+    let note = cut["note"].as_str().unwrap();
+    assert!(
+        note.contains("speed estimated from the harmonic comb"),
+        "{note}"
+    );
+}
+
 /// `chatter oma` overrides: a model order range, the segment count, an explicit harmonic list
 /// and no decimation reach the identification (the note reports the order and the imposed
 /// harmonics); bad values are clear errors naming the option or field.

@@ -22,7 +22,7 @@
 //!
 //! # Criterion
 //! A bin is synchronous when it lies within 2.5 df + k f_0 [`HARMONIC_TOLERANCE`] of a multiple
-//! k f_0 (or of a multiple of one of [`DetectionOptions::interference_hz`]). In the band
+//! k f_0 (or is a line of an interference comb, see [`DetectionOptions::interference`]). In the band
 //! [`DetectionOptions::min_frequency_hz`] .. [`DetectionOptions::max_frequency_hz`] the
 //! strongest non-synchronous local maximum of the density is the candidate line. What tells a
 //! self-excited vibration from a structural resonance driven by the random part of the cutting
@@ -361,8 +361,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             bases
         }
         Interference::Search { min_hz, max_hz } => {
-            if !(min_hz.is_finite() && max_hz.is_finite() && *min_hz > 0.0 && max_hz >= min_hz)
-            {
+            if !(min_hz.is_finite() && max_hz.is_finite() && *min_hz > 0.0 && max_hz >= min_hz) {
                 return Err(invalid(
                     "interference",
                     format!("search range {min_hz} to {max_hz} Hz; expected 0 < min <= max"),

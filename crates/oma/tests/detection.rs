@@ -187,8 +187,11 @@ fn sweep(name: &str, model: &ModalModel, speeds_rpm: &[f64]) {
     );
     assert!(accuracy >= 0.97, "{name}: {accuracy}");
     assert_eq!(freq_ok, chatter_count, "{name}");
-    // the same records with the speed unknown: the fundamental estimated from the harmonic comb
-    // is the spindle frequency (within 0.1 %) and the verdict is the one given the speed
+    // the same records with the speed unknown: how often the fundamental estimated from the
+    // harmonic comb is the spindle frequency (within 0.1 %) and the verdict the one given the
+    // speed. Reported, not asserted: it fails here (14/30 turning, 18/34 milling; the milling
+    // records' spindle harmonics are weak beside the tooth-passing comb, and the turning chatter
+    // records' four forced harmonics do not stand out as lines), see the signals5 note
     let mut estimated = 0;
     let mut same = 0;
     for c in &cases {
@@ -223,7 +226,10 @@ fn sweep(name: &str, model: &ModalModel, speeds_rpm: &[f64]) {
         .iter()
         .filter_map(|c| c.comb_hz.map(|f| (c.speed_rpm, c.ratio, f)))
         .collect();
-    assert!(combs.is_empty(), "{name}: false interference combs {combs:?}");
+    assert!(
+        combs.is_empty(),
+        "{name}: false interference combs {combs:?}"
+    );
 }
 
 #[test]
@@ -382,7 +388,10 @@ fn mains_combs_are_found_and_left_out() {
             comb.lines_hz.len()
         );
         assert!((comb.fundamental_hz - 50.0).abs() < 0.01, "{comb:?}");
-        assert!(comb.lines_hz.iter().all(|f| (f - 1300.0).abs() > 5.0), "{comb:?}");
+        assert!(
+            comb.lines_hz.iter().all(|f| (f - 1300.0).abs() > 5.0),
+            "{comb:?}"
+        );
         assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
         assert!(close(d.chatter_hz.unwrap(), 1300.8, &d), "{:?}", d.evidence);
     }
@@ -456,8 +465,8 @@ fn noise_is_stable_and_bad_options_are_errors() {
 /// The real record of a slot cut at 5000 rpm with a four-flute cutter, labelled chatter by its
 /// authors (`shared/data/real/milling_chatter_record`, MIT licence): detected as chatter, at a
 /// frequency that is neither a spindle harmonic nor a mains (50 Hz) harmonic (684 Hz). Its
-/// strongest non-synchronous line is 150 Hz, the third harmonic of a 50 Hz mains comb (70 lines
-/// from 50 to 4600 Hz), whose share of the power varies with the chatter bursts (V 0.56): with
+/// strongest non-synchronous line is 150 Hz, the third harmonic of a 50 Hz mains comb (lines at
+/// most multiples from 50 to 4600 Hz), whose share of the power varies with the chatter bursts (V 0.56): with
 /// the search off the verdict is stable. The default search finds the comb (fundamental within
 /// 0.05 Hz of 50 Hz, independent check: its lines are the multiples of 50 Hz to within 0.5 Hz);
 /// giving 50 Hz as a known fundamental gives the same verdict.
@@ -486,7 +495,10 @@ fn real_record_test255_is_chatter() {
         comb.low_members
     );
     assert!((comb.fundamental_hz - 50.0).abs() < 0.05, "{comb:?}");
-    assert!(comb.lines_hz.iter().all(|f| off(*f, 50.0) < 0.5), "{comb:?}");
+    assert!(
+        comb.lines_hz.iter().all(|f| off(*f, 50.0) < 0.5),
+        "{comb:?}"
+    );
     assert_eq!(d.verdict, Verdict::Chatter);
     let f = d.chatter_hz.unwrap();
     assert!(off(f, 5000.0 / 60.0) > 2.0 && off(f, 50.0) > 2.0, "{f}");
@@ -494,7 +506,11 @@ fn real_record_test255_is_chatter() {
     let known = detect(&s, &options).unwrap();
     assert_eq!(known.verdict, Verdict::Chatter);
     assert!(known.evidence.interference.is_none());
-    assert!((known.chatter_hz.unwrap() - f).abs() < 0.5, "{:?}", known.chatter_hz);
+    assert!(
+        (known.chatter_hz.unwrap() - f).abs() < 0.5,
+        "{:?}",
+        known.chatter_hz
+    );
     options.interference = Interference::Off;
     let blind = detect(&s, &options).unwrap();
     assert_eq!(blind.verdict, Verdict::Stable, "{:?}", blind.evidence);
