@@ -13,11 +13,22 @@
 //! the verdict (`chatter_dynamics::CutEvidence`: line frequency, V, margin, level ratios,
 //! spindle frequency, bin width). `--plot DIR` writes `DIR/detect-N.svg`, the
 //! spectrum of record N with the harmonics and the line marked.
+//!
+//! Unknown speed (`--estimate-speed`, e.g. a sound clip whose cutting conditions were not
+//! recorded): the records' `speed_rpm` is ignored and the spindle frequency is the fundamental
+//! of the record's harmonic comb in 10-500 Hz (600-30 000 rpm; `chatter_oma::interference::
+//! harmonic_fundamental`); the cut's `speed_rpm` is the estimate, and its note says so.
+//!
+//! Interference (mains hum): by default a comb of lines at the multiples of a 45-65 Hz
+//! fundamental is searched for (`chatter_oma::interference`) and its lines are left out; the
+//! `note` reports the comb found. `--interference-hz 50` (or a list) gives the fundamentals
+//! instead (every multiple left out), `--interference-hz none` turns it off.
 
 use crate::output::emit;
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{Cut, CutEvidence, ModalModel, Observations, Operation, SignalRecord};
 use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
+use chatter_oma::interference::{Interference, LOW_HARMONICS};
 use plotters::prelude::*;
 use std::path::PathBuf;
 
@@ -34,9 +45,14 @@ pub struct DetectArgs {
     /// Folder for one SVG spectrum per record (detect-1.svg, detect-2.svg, ...).
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// Fundamentals of other forced combs to leave out (Hz), e.g. the mains frequency 50 or 60.
+    /// Fundamentals of interference combs to leave out (Hz, comma-separated), e.g. the mains
+    /// 50 or 60; `none` for no interference; default: search a comb in 45-65 Hz.
     #[arg(long, value_delimiter = ',')]
-    pub interference_hz: Vec<f64>,
+    pub interference_hz: Vec<String>,
+    /// The spindle speed is unknown: estimate it from each record's harmonic comb (600 to
+    /// 30 000 rpm) instead of reading `speed_rpm`.
+    #[arg(long)]
+    pub estimate_speed: bool,
     /// Write the JSON here instead of stdout.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -71,6 +87,7 @@ pub fn run(args: &DetectArgs) -> Result<()> {
             crate::output::Folder::new("--plot", dir, &known)
         })
         .transpose()?;
+    let interference = interference(&args.interference_hz)?;
     let mut cuts = observations.cuts.clone();
     for (i, record) in observations.signals.iter().enumerate() {
         let context = || {
@@ -84,15 +101,19 @@ pub fn run(args: &DetectArgs) -> Result<()> {
         if let Some(m) = &model {
             crate::validate::channels_match(m, &signals.names, &context())?;
         }
-        let mut options = DetectionOptions::new(record.speed_rpm / 60.0);
+        let mut options = if args.estimate_speed {
+            DetectionOptions::unknown_speed()
+        } else {
+            DetectionOptions::new(record.speed_rpm / 60.0)
+        };
         options.once_per_rev_channel = record.once_per_rev_channel.clone();
-        options.interference_hz = args.interference_hz.clone();
+        options.interference = interference.clone();
         let detection = detect(&signals, &options).with_context(context)?;
         if let Some(folder) = &mut plots {
             let svg = draw(record, model.as_ref(), &detection).with_context(context)?;
             folder.add(format!("detect-{}.svg", i + 1), svg);
         }
-        cuts.push(cut(record, &detection));
+        cuts.push(cut(record, &detection, &interference, args.estimate_speed));
     }
     if let Some(folder) = plots {
         for path in folder.commit()? {
@@ -107,20 +128,77 @@ pub fn run(args: &DetectArgs) -> Result<()> {
     emit(args.out.as_deref(), &result.to_json_string())
 }
 
-fn cut(record: &SignalRecord, d: &Detection) -> Cut {
+/// The `--interference-hz` values: none given, a search over the mains range; `none`, no
+/// interference; else the fundamentals (Hz).
+pub(crate) fn interference(values: &[String]) -> Result<Interference> {
+    if values.is_empty() {
+        return Ok(Interference::default());
+    }
+    if values.len() == 1 && values[0].trim().eq_ignore_ascii_case("none") {
+        return Ok(Interference::Off);
+    }
+    values
+        .iter()
+        .map(|v| match v.trim().parse::<f64>() {
+            Ok(f) if f.is_finite() && f > 0.0 => Ok(f),
+            _ => bail!("--interference-hz `{v}`: expected fundamentals > 0 in Hz, or `none`"),
+        })
+        .collect::<Result<Vec<f64>>>()
+        .map(Interference::Known)
+}
+
+/// What interference was left out, for a note: the comb found, the fundamentals given, or
+/// nothing.
+pub(crate) fn interference_note(interference: &Interference, d: &Detection) -> String {
+    match (interference, &d.evidence.interference) {
+        (_, Some(c)) => format!(
+            "; interference comb found and left out: {:.3} Hz, {} lines ({} of the first {} \
+             multiples) up to {:.0} Hz",
+            c.fundamental_hz,
+            c.lines_hz.len(),
+            c.low_members,
+            LOW_HARMONICS,
+            c.lines_hz.last().copied().unwrap_or(0.0)
+        ),
+        (Interference::Search { min_hz, max_hz }, None) => {
+            format!("; no interference comb found in {min_hz}-{max_hz} Hz")
+        }
+        (Interference::Known(bases), None) => {
+            format!("; interference given: multiples of {bases:?} Hz left out")
+        }
+        (Interference::Off, None) => String::new(),
+    }
+}
+
+fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estimated: bool) -> Cut {
     let e = &d.evidence;
     let name = record.file.file_name().map_or_else(
         || record.file.display().to_string(),
         |n| n.to_string_lossy().into(),
     );
+    let (speed_rpm, speed_note) = if estimated {
+        let rpm = 60.0 * e.fundamental_hz;
+        (
+            rpm,
+            format!(
+                "; speed estimated from the harmonic comb: {:.3} Hz ({rpm:.0} rpm)",
+                e.fundamental_hz
+            ),
+        )
+    } else {
+        (record.speed_rpm, String::new())
+    };
     Cut {
-        speed_rpm: record.speed_rpm,
+        speed_rpm,
         depth_mm: record.depth_mm,
         stable: d.verdict == Verdict::Stable,
         chatter_hz: d.chatter_hz,
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,
-        note: Some(format!("detect {name}")),
+        note: Some(format!(
+            "detect {name}{speed_note}{}",
+            interference_note(interference, d)
+        )),
         evidence: Some(CutEvidence {
             fundamental_hz: e.fundamental_hz,
             line_hz: e.peak_hz,

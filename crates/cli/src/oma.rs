@@ -3,7 +3,8 @@
 //! Each record is read (CSV at the entry's `sample_rate_hz`, WAV or MP3 at its own rate), its
 //! `once_per_rev_channel` (if any) gives the spindle frequency and is taken out of the analysed
 //! channels. A record that chatter detection (`chatter_oma::detection`, with the spindle
-//! frequency and any `--interference-hz`) calls chatter is refused: its dominant line is a
+//! frequency and a mains comb found in the record, or the fundamentals of `--interference-hz`)
+//! calls chatter is refused: its dominant line is a
 //! limit cycle, not a structural pole; `--allow-chatter` identifies it anyway and says so in the
 //! pole's `note`. Then the dominant pole is identified with repeated segments
 //! (`chatter_oma::identify`):
@@ -69,9 +70,10 @@ pub struct OmaArgs {
     /// Decimation factor before LSCE (1: none; default automatic).
     #[arg(long)]
     pub decimation: Option<usize>,
-    /// Fundamentals of other forced combs for the chatter check (Hz), e.g. the mains 50 or 60.
+    /// Fundamentals of interference combs for the chatter check (Hz, comma-separated), e.g.
+    /// the mains 50 or 60; `none` for no interference; default: search a comb in 45-65 Hz.
     #[arg(long, value_delimiter = ',')]
-    pub interference_hz: Vec<f64>,
+    pub interference_hz: Vec<String>,
     /// Identify records that chatter detection calls chatter (flagged in the pole's `note`).
     #[arg(long)]
     pub allow_chatter: bool,
@@ -148,6 +150,8 @@ struct Analysis {
     method: String,
     /// The chatter verdict, when `--allow-chatter` let a chattering record through.
     chatter_hz: Option<f64>,
+    /// The interference left out by the chatter check (`detect::interference_note`).
+    interference: String,
 }
 
 /// The `--harmonics-hz` override: `none` or frequencies.
@@ -189,14 +193,17 @@ fn analyse(
         signals = signals.without_channel(c)?;
     }
     let mut detection_options = DetectionOptions::new(1.0 / revolution_s);
-    detection_options.interference_hz = args.interference_hz.clone();
+    detection_options.interference = crate::detect::interference(&args.interference_hz)?;
     let detection = detect(&signals, &detection_options)?;
+    let interference =
+        crate::detect::interference_note(&detection_options.interference, &detection);
     let chatter_hz = match (detection.verdict, args.allow_chatter) {
         (Verdict::Stable, _) => None,
         (Verdict::Chatter, false) => bail!(
             "chatter detection calls this record chatter at {:.2} Hz (line variation V {:.3}, \
-             margin {:+.3}): a chattering cut is not an OMA record, its dominant line is a limit \
-             cycle, not a structural pole; pass --allow-chatter to identify it anyway",
+             margin {:+.3}{interference}): a chattering cut is not an OMA record, its dominant \
+             line is a limit cycle, not a structural pole; pass --allow-chatter to identify it \
+             anyway",
             detection.evidence.peak_hz,
             detection.evidence.line_variation,
             detection.evidence.margin
@@ -241,6 +248,7 @@ fn analyse(
         lifting,
         method,
         chatter_hz,
+        interference,
     })
 }
 
@@ -285,14 +293,15 @@ fn pole_observation(record: &SignalRecord, a: &Analysis) -> PoleObservation {
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,
         note: Some(format!(
-            "OMA of {}: {}{decimation}, order {}, {} lags{harmonics}{rejected}{flag}",
+            "OMA of {}: {}{decimation}, order {}, {} lags{harmonics}{rejected}{flag}{}",
             record.file.file_name().map_or_else(
                 || record.file.display().to_string(),
                 |n| n.to_string_lossy().into()
             ),
             a.method,
             a.id.order,
-            a.id.segment_lags
+            a.id.segment_lags,
+            a.interference
         )),
     }
 }

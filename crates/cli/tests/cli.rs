@@ -906,7 +906,11 @@ fn detect_labels_simulated_cuts() {
     assert_eq!(cuts[1]["stable"], false, "{out}");
     let f = cuts[1]["chatter_hz"].as_f64().unwrap();
     assert!((740.0..790.0).contains(&f), "{f}");
-    assert_eq!(cuts[1]["note"], "detect chatter.csv");
+    // the simulator adds no mains hum: the note says none was found
+    assert_eq!(
+        cuts[1]["note"],
+        "detect chatter.csv; no interference comb found in 45-65 Hz"
+    );
     let evidence = &cuts[1]["evidence"];
     assert!(
         (evidence["line_hz"].as_f64().unwrap() - f).abs() < 1e-9,
@@ -980,12 +984,16 @@ fn zoa_lobes_include_process_damping() {
     }
 }
 
-/// `chatter oma` on the real chatter record `test255_accelY.csv` (shared data folder; slot
-/// milling at 5000 rpm, labelled chatter by its authors): with the mains frequency given,
-/// chatter detection calls it chatter and the OMA refuses it, naming the option that overrides
-/// the refusal; with `--allow-chatter` the pole is flagged in its note and is no forced line
-/// (at least 1 Hz from every multiple of 50 Hz and of the spindle frequency: before issue 16 it
-/// was 150.01 Hz). Skipped with a message when the data are absent.
+/// `chatter detect` and `chatter oma` on the real chatter record `test255_accelY.csv` (shared
+/// data folder; slot milling at 5000 rpm, labelled chatter by its authors), without the mains
+/// frequency given: detection finds the 50 Hz mains comb, reports it in the cut's note, and
+/// calls the record chatter (near 684 Hz, off every multiple of 50 Hz and of the spindle
+/// frequency); the OMA refuses the record, naming the comb and the option that overrides the
+/// refusal, and still does with the mains given (`--interference-hz 50`); with
+/// `--allow-chatter` the pole is flagged in its note and is no forced line (at least 1 Hz from
+/// every multiple of 50 Hz and of the spindle frequency: before issue 16 it was 150.01 Hz).
+/// `--interference-hz none` turns the search off (detection then says stable: the 150 Hz mains
+/// line wins); a bad value is a clear error. Skipped with a message when the data are absent.
 #[test]
 fn oma_refuses_the_real_chatter_record() {
     let record = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -1005,24 +1013,88 @@ fn oma_refuses_the_real_chatter_record() {
         ),
     )
     .unwrap();
+    let off = |f: f64, base: f64| (f - (f / base).round().max(1.0) * base).abs();
+    let detect = ["detect", "--observations", obs.to_str().unwrap()];
+    let out = succeed(chatter().args(detect));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cut = &json["cuts"][0];
+    assert_eq!(cut["stable"], false, "{cut}");
+    let f = cut["chatter_hz"].as_f64().unwrap();
+    assert!(off(f, 50.0) > 2.0 && off(f, 5000.0 / 60.0) > 2.0, "{cut}");
+    let note = cut["note"].as_str().unwrap();
+    assert!(
+        note.contains("interference comb found and left out: 50.0"),
+        "{note}"
+    );
+    let out = succeed(chatter().args(detect).args(["--interference-hz", "none"]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(json["cuts"][0]["stable"], true, "{out}");
+    let err = fail(chatter().args(detect).args(["--interference-hz", "50,x"]));
+    assert!(err.contains("--interference-hz `x`"), "{err}");
+
     let args = ["oma", "--observations", obs.to_str().unwrap()];
-    let err = fail(chatter().args(args).args(["--interference-hz", "50"]));
+    let err = fail(chatter().args(args));
     assert!(
         err.contains("chatter detection calls this record chatter")
+            && err.contains("interference comb found and left out: 50.0")
             && err.contains("--allow-chatter"),
         "{err}"
     );
-    let out = succeed(
-        chatter()
-            .args(args)
-            .args(["--interference-hz", "50", "--allow-chatter"]),
+    let err = fail(chatter().args(args).args(["--interference-hz", "50"]));
+    assert!(
+        err.contains("chatter detection calls this record chatter")
+            && err.contains("interference given"),
+        "{err}"
     );
+    let out = succeed(chatter().args(args).args(["--allow-chatter"]));
     let json: serde_json::Value = serde_json::from_str(&out).unwrap();
     let pole = &json["poles"][0];
     assert!(pole["note"].as_str().unwrap().contains("FLAGGED"), "{pole}");
     let f = pole["frequency_hz"].as_f64().unwrap();
-    let off = |base: f64| (f - (f / base).round().max(1.0) * base).abs();
-    assert!(off(50.0) > 1.0 && off(5000.0 / 60.0) > 1.0, "{pole}");
+    assert!(off(f, 50.0) > 1.0 && off(f, 5000.0 / 60.0) > 1.0, "{pole}");
+}
+
+/// `chatter detect --estimate-speed` on the no-chatter sound clip of the shared data folder
+/// (cutting conditions not recorded): the spindle speed is estimated from the clip's harmonic
+/// comb at 5496 rpm (91.6 Hz; its lines 91.5, 366.7, 732.8, 1007.4, 1099.5 Hz are multiples 1, 4,
+/// 8, 11, 12, checked with a separate Welch spectrum), written as the cut's `speed_rpm` and named
+/// in its note, and the cut is stable, as labelled. Skipped with a message when the data are
+/// absent.
+#[test]
+fn detect_estimates_the_speed_of_a_sound_clip() {
+    let clip = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/real/milling_chatter_record/metalcutting_nochatter8058.mp3");
+    if !clip.exists() {
+        eprintln!("skipped: {} is absent", clip.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obs = dir.path().join("obs.json");
+    std::fs::write(
+        &obs,
+        format!(
+            r#"{{ "signals": [ {{ "file": {:?}, "speed_rpm": 1000, "depth_mm": 1,
+                 "quantity": "sound" }} ] }}"#,
+            clip.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let out = succeed(chatter().args([
+        "detect",
+        "--estimate-speed",
+        "--observations",
+        obs.to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cut = &json["cuts"][0];
+    assert_eq!(cut["stable"], true, "{cut}");
+    let rpm = cut["speed_rpm"].as_f64().unwrap();
+    assert!((rpm - 5496.0).abs() < 6.0, "{cut}");
+    let note = cut["note"].as_str().unwrap();
+    assert!(
+        note.contains("speed estimated from the harmonic comb"),
+        "{note}"
+    );
 }
 
 /// `chatter oma` overrides: a model order range, the segment count, an explicit harmonic list

@@ -18,10 +18,10 @@ fn main() {
         let mut o = DetectionOptions::new(5000.0 / 60.0);
         let d0 = detect(&s, &o).unwrap();
         println!(
-            "test255 without mains: {:?} {:?} {:?}",
+            "test255, mains comb searched: {:?} {:?} {:?}",
             d0.verdict, d0.chatter_hz, d0.evidence
         );
-        o.interference_hz = vec![50.0];
+        o.interference = chatter_oma::interference::Interference::Known(vec![50.0]);
         let d = detect(&s, &o).unwrap();
         println!(
             "test255: {:?} {:?} {:?}",

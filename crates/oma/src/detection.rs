@@ -14,11 +14,15 @@
 //! Without a once-per-revolution channel the nominal f_0 is refined within
 //! +-[`DetectionOptions::speed_tolerance`] to the value that maximizes sum_k ln S(k f_0) over the
 //! harmonics in the band (a logarithmic comb, so a single strong chatter line cannot pull the
-//! comb onto itself); with one, f_0 is the pulse rate.
+//! comb onto itself); with one, f_0 is the pulse rate. When the speed is unknown
+//! ([`Fundamental::Search`], e.g. a sound clip whose cutting conditions were not recorded), f_0
+//! is the fundamental of the record's harmonic comb in the given range
+//! ([`crate::interference::harmonic_fundamental`]: the most lines at its first 12 multiples, the
+//! lowest of equally good submultiples); a record without such a comb is an error.
 //!
 //! # Criterion
 //! A bin is synchronous when it lies within 2.5 df + k f_0 [`HARMONIC_TOLERANCE`] of a multiple
-//! k f_0 (or of a multiple of one of [`DetectionOptions::interference_hz`]). In the band
+//! k f_0 (or is a line of an interference comb, see [`DetectionOptions::interference`]). In the band
 //! [`DetectionOptions::min_frequency_hz`] .. [`DetectionOptions::max_frequency_hz`] the
 //! strongest non-synchronous local maximum of the density is the candidate line. What tells a
 //! self-excited vibration from a structural resonance driven by the random part of the cutting
@@ -42,16 +46,23 @@
 //! against everything else in the band, both less the floor, in dB.
 //!
 //! A stationary deterministic line that is not a multiple of f_0 (mains hum, a neighbouring
-//! machine) has a constant amplitude too: give its fundamental in
-//! [`DetectionOptions::interference_hz`]. Period-doubling (flip) chatter of a cutter with an even
+//! machine) has a constant amplitude too. By default ([`Interference::Search`]) a comb of such
+//! lines with a fundamental in 45-65 Hz is searched for (see [`crate::interference`]) and its
+//! member lines are synchronous as well; the comb found is reported in
+//! [`DetectionEvidence::interference`]. Known fundamentals ([`Interference::Known`]) make every
+//! one of their multiples synchronous instead. Period-doubling (flip) chatter of a cutter with an even
 //! number of teeth lies on spindle harmonics and is not detected.
 //!
 //! The chatter frequency is the line's, refined by a parabola through the logarithms of the
 //! three densities around it.
 
 use crate::error::{OmaError, Result};
+use crate::interference::{
+    Interference, InterferenceComb, LOW_HARMONICS, MIN_LOW_MEMBERS, find_comb,
+    harmonic_fundamental, spectral_lines,
+};
 use crate::signals::Signals;
-use crate::spectrum::{Spectrum, power_spectral_density};
+use crate::spectrum::{Spectrum, power_spectral_density, refine_peak_hz};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -71,15 +82,45 @@ pub const HARMONIC_TOLERANCE: f64 = 5e-4;
 /// Default relative search range of the fundamental around its nominal value.
 pub const SPEED_TOLERANCE: f64 = 0.005;
 
+/// Default range of the spindle frequency searched when it is unknown (Hz): 600 to 30 000 rpm.
+pub const SPINDLE_RANGE_HZ: (f64, f64) = (10.0, 500.0);
+
+/// Where the fundamental f_0 comes from (a once-per-revolution channel overrides both).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fundamental {
+    /// The spindle rotation frequency rpm / 60 (Hz), refined within
+    /// [`DetectionOptions::speed_tolerance`].
+    Nominal(f64),
+    /// Unknown speed: the fundamental of the record's harmonic comb in `min_hz` to `max_hz`
+    /// (default [`SPINDLE_RANGE_HZ`]).
+    Search {
+        /// Lowest fundamental (Hz).
+        min_hz: f64,
+        /// Highest fundamental (Hz).
+        max_hz: f64,
+    },
+}
+
+impl Fundamental {
+    /// The lowest fundamental it can be (Hz): the scale of the default resolution and band.
+    fn lowest_hz(self) -> f64 {
+        match self {
+            Self::Nominal(f) => f,
+            Self::Search { min_hz, .. } => min_hz,
+        }
+    }
+}
+
 /// Options of [`detect`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DetectionOptions {
-    /// Nominal fundamental (Hz): the spindle rotation frequency, rpm / 60.
-    pub fundamental_hz: f64,
-    /// Finest bin width wanted (Hz); default `None`: f_0 / 10, at most 2 Hz, with at least 8
-    /// segments in the record.
+    /// The fundamental: nominal (the spindle rotation frequency) or searched.
+    pub fundamental: Fundamental,
+    /// Finest bin width wanted (Hz); default `None`: f_0 / 10 (the lowest f_0 searched), at
+    /// most 2 Hz, with at least 8 segments in the record.
     pub resolution_hz: Option<f64>,
-    /// Lowest frequency searched (Hz); default `None`: f_0 / 2.
+    /// Lowest frequency searched (Hz); default `None`: f_0 / 2 (the lowest f_0 searched).
     pub min_frequency_hz: Option<f64>,
     /// Highest frequency searched (Hz); default `None`: 0.45 times the sample rate.
     pub max_frequency_hz: Option<f64>,
@@ -94,16 +135,29 @@ pub struct DetectionOptions {
     pub min_burst_variation: f64,
     /// Name of a once-per-revolution channel: excluded from the spectrum, its pulse rate is f_0.
     pub once_per_rev_channel: Option<String>,
-    /// Fundamentals of other known forced combs (Hz), e.g. the mains frequency whose harmonics
-    /// an accelerometer cable picks up; their multiples are synchronous too (default none).
-    pub interference_hz: Vec<f64>,
+    /// Interference combs (mains hum) whose lines are synchronous too: searched for in
+    /// 45-65 Hz by default, given, or none.
+    pub interference: Interference,
 }
 
 impl DetectionOptions {
-    /// Options with the documented defaults for fundamental `fundamental_hz`.
+    /// Options with the documented defaults for the nominal fundamental `fundamental_hz`.
     pub fn new(fundamental_hz: f64) -> Self {
+        Self::with_fundamental(Fundamental::Nominal(fundamental_hz))
+    }
+
+    /// Options with the documented defaults for an unknown speed: the fundamental is searched
+    /// over [`SPINDLE_RANGE_HZ`].
+    pub fn unknown_speed() -> Self {
+        Self::with_fundamental(Fundamental::Search {
+            min_hz: SPINDLE_RANGE_HZ.0,
+            max_hz: SPINDLE_RANGE_HZ.1,
+        })
+    }
+
+    fn with_fundamental(fundamental: Fundamental) -> Self {
         Self {
-            fundamental_hz,
+            fundamental,
             resolution_hz: None,
             min_frequency_hz: None,
             max_frequency_hz: None,
@@ -111,7 +165,7 @@ impl DetectionOptions {
             max_line_variation: MAX_LINE_VARIATION,
             min_burst_variation: MIN_BURST_VARIATION,
             once_per_rev_channel: None,
-            interference_hz: Vec::new(),
+            interference: Interference::default(),
         }
     }
 }
@@ -153,6 +207,8 @@ pub struct DetectionEvidence {
     /// half: about 1 for a stable resonance driven by random forces (a narrowband Gaussian
     /// process), near 0 for a limit cycle.
     pub line_variation: f64,
+    /// The interference comb found and left out ([`Interference::Search`]), if any.
+    pub interference: Option<InterferenceComb>,
 }
 
 /// Result of [`detect`].
@@ -180,11 +236,23 @@ fn invalid(field: &'static str, message: String) -> OmaError {
 pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection> {
     let fs = signals.sample_rate_hz;
     let nyquist = fs / 2.0;
-    let f0_nominal = options.fundamental_hz;
-    if !(f0_nominal.is_finite() && f0_nominal > 0.0 && f0_nominal < nyquist) {
+    let f0_lowest = options.fundamental.lowest_hz();
+    let f0_highest = match options.fundamental {
+        Fundamental::Nominal(f) => f,
+        Fundamental::Search { max_hz, .. } => max_hz,
+    };
+    if !(f0_lowest.is_finite()
+        && f0_highest.is_finite()
+        && f0_lowest > 0.0
+        && f0_highest >= f0_lowest
+        && f0_highest < nyquist)
+    {
         return Err(invalid(
             "fundamental_hz",
-            format!("{f0_nominal} Hz; expected a frequency in (0, {nyquist}) Hz"),
+            format!(
+                "{f0_lowest} to {f0_highest} Hz; expected a frequency (or range) in (0, \
+                 {nyquist}) Hz"
+            ),
         ));
     }
     if !(options.speed_tolerance.is_finite() && (0.0..0.2).contains(&options.speed_tolerance)) {
@@ -231,7 +299,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             ));
         }
         Some(r) => r,
-        None => (f0_nominal / 10.0).min(2.0),
+        None => (f0_lowest / 10.0).min(2.0),
     };
     // segment: a power of two with df <= resolution, at most an eighth of the record (at
     // least 64 samples)
@@ -267,7 +335,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             *a += b;
         }
     }
-    let lo = options.min_frequency_hz.unwrap_or(f0_nominal / 2.0);
+    let lo = options.min_frequency_hz.unwrap_or(f0_lowest / 2.0);
     let hi = options.max_frequency_hz.unwrap_or(0.45 * fs).min(nyquist);
     if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo + 8.0 * df) {
         return Err(invalid(
@@ -278,25 +346,73 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let first = ((lo / df).ceil() as usize).max(1);
     let last = ((hi / df).floor() as usize).min(psd.len() - 1);
 
-    let f0 = f0_pulse.unwrap_or_else(|| refine_fundamental(&psd, df, f0_nominal, hi, options));
-    if let Some(f) = options
-        .interference_hz
-        .iter()
-        .find(|f| !(f.is_finite() && **f > 0.0))
-    {
-        return Err(invalid(
-            "interference_hz",
-            format!("{f} Hz; expected fundamentals > 0 Hz"),
-        ));
-    }
     let near_multiple = |f: f64, base: f64| {
         let k = (f / base).round().max(1.0);
         (f - k * base).abs() <= 2.5 * df + k * base * HARMONIC_TOLERANCE
     };
-    let synchronous = |i: usize| {
-        let f = i as f64 * df;
-        near_multiple(f, f0) || options.interference_hz.iter().any(|b| near_multiple(f, *b))
+    let known: &[f64] = match &options.interference {
+        Interference::Known(bases) => {
+            if let Some(f) = bases.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+                return Err(invalid(
+                    "interference",
+                    format!("{f} Hz; expected fundamentals > 0 Hz"),
+                ));
+            }
+            bases
+        }
+        Interference::Search { min_hz, max_hz } => {
+            if !(min_hz.is_finite() && max_hz.is_finite() && *min_hz > 0.0 && max_hz >= min_hz) {
+                return Err(invalid(
+                    "interference",
+                    format!("search range {min_hz} to {max_hz} Hz; expected 0 < min <= max"),
+                ));
+            }
+            &[]
+        }
+        Interference::Off => &[],
     };
+    let interference_search = |spindle_hz: Option<f64>| match options.interference {
+        Interference::Search { min_hz, max_hz } => {
+            let lines = spectral_lines(&psd, df, first, last, |f| {
+                spindle_hz.is_some_and(|f0| near_multiple(f, f0))
+            });
+            find_comb(&lines, df, (min_hz, max_hz), spindle_hz)
+        }
+        _ => None,
+    };
+    let f0 = match (f0_pulse, options.fundamental) {
+        (Some(f), _) => f,
+        (None, Fundamental::Nominal(f)) => refine_fundamental(&psd, df, f, hi, options),
+        (None, Fundamental::Search { min_hz, max_hz }) => {
+            // interference first, so that a mains comb is not taken for the spindle's
+            let hum = interference_search(None);
+            let hum_lines: &[f64] = hum.as_ref().map_or(&[], |c| &c.lines_hz);
+            let lines = spectral_lines(&psd, df, first, last, |f| {
+                known.iter().any(|b| near_multiple(f, *b))
+                    || hum_lines.iter().any(|l| (f - l).abs() <= 2.5 * df)
+            });
+            harmonic_fundamental(&lines, df, (min_hz, max_hz))
+                .ok_or_else(|| {
+                    OmaError::NoPole(format!(
+                        "no harmonic comb with a fundamental in {min_hz}-{max_hz} Hz (lines at \
+                         {MIN_LOW_MEMBERS} of its first {LOW_HARMONICS} multiples): the \
+                         spindle frequency cannot be estimated; give the speed"
+                    ))
+                })?
+                .fundamental_hz
+        }
+    };
+    let comb = interference_search(Some(f0));
+    let comb_lines: &[f64] = comb.as_ref().map_or(&[], |c| &c.lines_hz);
+    let synchronous_bins: Vec<bool> = (0..psd.len())
+        .map(|i| {
+            let f = i as f64 * df;
+            near_multiple(f, f0)
+                || known.iter().any(|b| near_multiple(f, *b))
+                || comb_lines.iter().any(|l| (f - l).abs() <= 2.5 * df)
+        })
+        .collect();
+    let synchronous = |i: usize| synchronous_bins[i];
     let mut floor_values: Vec<f64> = (first..=last)
         .filter(|i| !synchronous(*i))
         .map(|i| psd[i])
@@ -340,7 +456,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let line_to_rest_db = 10.0 * ((e_line + tiny) / (e_sync + e_rest + floor * df)).log10();
     let line_to_forced_db = 10.0 * ((e_line + tiny) / (e_sync + floor * df)).log10();
     let line_to_floor_db = 10.0 * (psd[peak] / floor.max(tiny)).log10();
-    let peak_hz = refine_peak(&psd, peak, df);
+    let peak_hz = refine_peak_hz(&psd, peak, df);
     let line_variation = line_variation(&signals.data, segment, peak);
     let margin = (options.max_line_variation - line_variation)
         .max(line_variation - options.min_burst_variation);
@@ -368,6 +484,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             margin,
             resolution_hz: df,
             line_variation,
+            interference: comb,
         },
         spectrum: Spectrum {
             frequencies_hz: (0..psd.len()).map(|i| i as f64 * df).collect(),
@@ -406,21 +523,6 @@ fn refine_fundamental(psd: &[f64], df: f64, f0: f64, hi: f64, options: &Detectio
         })
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(f0, |(f, _)| f)
-}
-
-/// Peak frequency from a parabola through the logarithms of the densities at bins i-1, i, i+1.
-fn refine_peak(psd: &[f64], i: usize, df: f64) -> f64 {
-    if i == 0 || i + 1 >= psd.len() {
-        return i as f64 * df;
-    }
-    let (a, b, c) = (psd[i - 1].ln(), psd[i].ln(), psd[i + 1].ln());
-    let denom = a - 2.0 * b + c;
-    let shift = if denom.abs() > 0.0 && denom.is_finite() {
-        (0.5 * (a - c) / denom).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    };
-    (i as f64 + shift) * df
 }
 
 /// Coefficient of variation of the line's share of the power over the record's second half

@@ -26,6 +26,7 @@
 //! - [`spectrum`]: first singular value of the cross-PSD matrix; Welch densities.
 //! - [`detection`]: chatter detection, self-excited lines against the harmonics of a
 //!   fundamental.
+//! - [`interference`]: combs of lines at the multiples of a non-spindle fundamental (mains).
 //! - [`synthetic`]: seeded records with known poles (the reference problems of tests and
 //!   benches).
 //! - [`identify`](mod@identify): all of it in one call, with repeated identification on random
@@ -47,6 +48,7 @@ pub mod detection;
 pub mod error;
 pub mod harmonics;
 pub mod identify;
+pub mod interference;
 pub mod lifting;
 pub mod lsce;
 pub mod picking;

@@ -8,7 +8,8 @@
 //!    simulator's own: the highest peak of a one-FFT periodogram of the noise-free `x` (or
 //!    `feed`) channel over the record's second half, away from the spindle harmonics.
 //! 2. Records built here without the simulator: spindle harmonics, a self-excited sinusoid that
-//!    grows into a limit cycle (or is absent), noise.
+//!    grows into a limit cycle (or is absent), noise, and a mains comb (or none); the simulated
+//!    records carry no mains hum, so no interference comb may be found in them.
 //! 3. The real record `test255_accelY.csv` (labelled chatter by its authors), when the shared
 //!    data folder is present.
 #![allow(clippy::unwrap_used)]
@@ -17,6 +18,7 @@ use chatter_dynamics::ModalModel;
 use chatter_dynamics::examples::{ahmadi_2022_turning, schmitz_2023_milling};
 use chatter_dynamics::simulate::{SimulationSettings, simulate};
 use chatter_oma::detection::{DetectionOptions, Verdict, detect};
+use chatter_oma::interference::Interference;
 use chatter_oma::signals::Signals;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::Discretization;
@@ -43,6 +45,9 @@ struct Case {
     resolution_hz: f64,
     variation: f64,
     peak_hz: f64,
+    comb_hz: Option<f64>,
+    /// Detection without the speed: the estimated fundamental and the verdict (None: no comb).
+    unknown_speed: Option<(f64, Verdict, Option<f64>)>,
 }
 
 /// Highest periodogram peak of the second half of `x`, at least 3 bins from every multiple of
@@ -84,6 +89,9 @@ fn run_case(model: &ModalModel, speed_rpm: f64, b_lim: f64, ratio: f64, seed: u6
         .collect();
     let signals = Signals::new(vec!["a".into(), "b".into()], FS_HZ, data).unwrap();
     let d = detect(&signals, &DetectionOptions::new(f0)).unwrap();
+    let unknown_speed = detect(&signals, &DetectionOptions::unknown_speed())
+        .ok()
+        .map(|u| (u.evidence.fundamental_hz, u.verdict, u.chatter_hz));
     Case {
         speed_rpm,
         ratio,
@@ -96,6 +104,8 @@ fn run_case(model: &ModalModel, speed_rpm: f64, b_lim: f64, ratio: f64, seed: u6
         resolution_hz: d.evidence.resolution_hz,
         variation: d.evidence.line_variation,
         peak_hz: d.evidence.peak_hz,
+        comb_hz: d.evidence.interference.map(|c| c.fundamental_hz),
+        unknown_speed,
     }
 }
 
@@ -177,6 +187,49 @@ fn sweep(name: &str, model: &ModalModel, speeds_rpm: &[f64]) {
     );
     assert!(accuracy >= 0.97, "{name}: {accuracy}");
     assert_eq!(freq_ok, chatter_count, "{name}");
+    // the same records with the speed unknown: how often the fundamental estimated from the
+    // harmonic comb is the spindle frequency (within 0.1 %) and the verdict the one given the
+    // speed. Reported, not asserted: it fails here (14/30 turning, 18/34 milling; the milling
+    // records' spindle harmonics are weak beside the tooth-passing comb, and the turning chatter
+    // records' four forced harmonics do not stand out as lines), see the signals5 note
+    let mut estimated = 0;
+    let mut same = 0;
+    for c in &cases {
+        let f0 = c.speed_rpm / 60.0;
+        match c.unknown_speed {
+            Some((f, verdict, chatter_hz)) => {
+                let right_f0 = (f / f0 - 1.0).abs() <= 1e-3;
+                estimated += usize::from(right_f0);
+                let agree = right_f0 && verdict == c.verdict && chatter_hz == c.chatter_hz;
+                same += usize::from(agree);
+                if !agree {
+                    eprintln!(
+                        "{name} {:6.0} rpm {:.2} b_lim, speed unknown: f0 {f:.3} Hz (true \
+                         {f0:.3}), {verdict:?} at {chatter_hz:?} Hz",
+                        c.speed_rpm, c.ratio
+                    );
+                }
+            }
+            None => eprintln!(
+                "{name} {:6.0} rpm {:.2} b_lim, speed unknown: no comb",
+                c.speed_rpm, c.ratio
+            ),
+        }
+    }
+    eprintln!(
+        "{name}, speed unknown: fundamental right in {estimated}/{n}, same verdict and chatter \
+         frequency in {same}/{n}",
+        n = cases.len()
+    );
+    // the simulator adds no mains hum: any interference comb found is a false one
+    let combs: Vec<(f64, f64, f64)> = cases
+        .iter()
+        .filter_map(|c| c.comb_hz.map(|f| (c.speed_rpm, c.ratio, f)))
+        .collect();
+    assert!(
+        combs.is_empty(),
+        "{name}: false interference combs {combs:?}"
+    );
 }
 
 #[test]
@@ -197,11 +250,22 @@ fn simulated_turning_lobe_diagram() {
     );
 }
 
+/// Which multiples of an interference fundamental a built record carries.
+#[derive(Debug, Clone, Copy)]
+enum Comb {
+    /// Multiples 1 to 40.
+    All,
+    /// Odd multiples 1 to 39 (the even ones are empty).
+    Odd,
+}
+
 /// A record built here: harmonics of 80 Hz (forced), optionally a self-excited sinusoid at
-/// 1234.5 Hz growing from 1e-3 into a limit cycle of amplitude 0.5 (logistic growth, rate 8 1/s),
-/// a lightly damped resonance at 1100 Hz driven by white noise (a Gaussian narrowband process),
-/// and 10 % white measurement noise; 4 s at 10 kHz, two channels.
-fn built_record(chatter: bool, seed: u64) -> Signals {
+/// `chatter_hz` growing from 1e-3 into a limit cycle of amplitude 0.5 (logistic growth, rate
+/// 8 1/s), a lightly damped resonance at 1100 Hz driven by white noise (a Gaussian narrowband
+/// process), optionally a mains comb (fundamental, multiples: amplitude 0.6 at the third
+/// harmonic, 0.2 / sqrt(k) at the others, fixed phases), and 10 % white measurement noise; 4 s
+/// at 10 kHz, two channels.
+fn built_record(chatter_hz: Option<f64>, mains: Option<(f64, Comb)>, seed: u64) -> Signals {
     let fs = 10_000.0;
     let n = 40_000;
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
@@ -222,13 +286,21 @@ fn built_record(chatter: bool, seed: u64) -> Signals {
                 (2.0 * std::f64::consts::PI * 80.0 * h as f64 * t + 0.3 * h as f64).cos() / h as f64
             })
             .sum();
-        let amplitude = if chatter {
-            0.5 / (1.0 + (0.5 / 1e-3 - 1.0) * (-8.0 * t).exp())
-        } else {
-            0.0
-        };
-        let selfexcited = amplitude * (2.0 * std::f64::consts::PI * 1234.5 * t).sin();
-        let clean = forced + y + selfexcited;
+        let selfexcited = chatter_hz.map_or(0.0, |f| {
+            let amplitude = 0.5 / (1.0 + (0.5 / 1e-3 - 1.0) * (-8.0 * t).exp());
+            amplitude * (2.0 * std::f64::consts::PI * f * t).sin()
+        });
+        let hum: f64 = mains.map_or(0.0, |(f, comb)| {
+            (1..=40usize)
+                .filter(|k| matches!(comb, Comb::All) || k % 2 == 1)
+                .map(|k| {
+                    let amplitude = if k == 3 { 0.6 } else { 0.2 / (k as f64).sqrt() };
+                    let phase = 0.7 * (k * k) as f64;
+                    amplitude * (2.0 * std::f64::consts::PI * f * k as f64 * t + phase).cos()
+                })
+                .sum()
+        });
+        let clean = forced + y + selfexcited + hum;
         for (c, ch) in channels.iter_mut().enumerate() {
             let noise: f64 = StandardNormal.sample(&mut rng);
             ch.push((1.0 + 0.3 * c as f64) * clean + 0.1 * noise);
@@ -241,21 +313,132 @@ fn built_record(chatter: bool, seed: u64) -> Signals {
 fn built_records_with_and_without_a_limit_cycle() {
     for seed in 0..5 {
         let options = DetectionOptions::new(80.0);
-        let with = detect(&built_record(true, seed), &options).unwrap();
+        let with = detect(&built_record(Some(1234.5), None, seed), &options).unwrap();
         assert_eq!(with.verdict, Verdict::Chatter, "{:?}", with.evidence);
         let f = with.chatter_hz.unwrap();
         assert!(
             (f - 1234.5).abs() <= (0.01 * 1234.5f64).min(with.evidence.resolution_hz),
             "{f}"
         );
-        let without = detect(&built_record(false, seed), &options).unwrap();
+        let without = detect(&built_record(None, None, seed), &options).unwrap();
         assert_eq!(without.verdict, Verdict::Stable, "{:?}", without.evidence);
         assert!(without.chatter_hz.is_none());
+        assert!(with.evidence.interference.is_none() && without.evidence.interference.is_none());
         eprintln!(
             "seed {seed}: chatter at {f:.2} Hz, V {:.2}; without: V {:.2} at {:.1} Hz",
             with.evidence.line_variation, without.evidence.line_variation, without.evidence.peak_hz
         );
     }
+}
+
+/// Mains hum: the built records above with a 50.02 Hz or 59.97 Hz comb whose third harmonic is
+/// the strongest line besides the forced ones. A mains line has a constant amplitude, so left in
+/// it would be called chatter in a stable record (checked with the search off) and would hide the
+/// self-excited line in a chattering one. Searched for (the default), the comb is found within
+/// 0.01 Hz, and the verdicts and the chatter frequency are those of the records without hum.
+/// Controls: a chatter line 0.8 Hz from 26 x 50 Hz in a record without hum (no comb found, the
+/// line is chatter) and in a record whose comb has only odd multiples (the comb is found, the line
+/// near its empty 26th multiple is not a member and is chatter).
+#[test]
+fn mains_combs_are_found_and_left_out() {
+    let options = DetectionOptions::new(80.0);
+    let mut off = options.clone();
+    off.interference = Interference::Off;
+    let close = |f: f64, want: f64, d: &chatter_oma::detection::Detection| {
+        (f - want).abs() <= (0.01 * want).min(d.evidence.resolution_hz)
+    };
+    for seed in 0..3 {
+        for mains_hz in [50.02, 59.97] {
+            let stable = built_record(None, Some((mains_hz, Comb::All)), seed);
+            let d = detect(&stable, &options).unwrap();
+            let comb = d.evidence.interference.clone().unwrap();
+            eprintln!(
+                "seed {seed}, {mains_hz} Hz hum, stable: {:?}, V {:.2} at {:.1} Hz, comb {:.4} Hz \
+                 ({} lines)",
+                d.verdict,
+                d.evidence.line_variation,
+                d.evidence.peak_hz,
+                comb.fundamental_hz,
+                comb.lines_hz.len()
+            );
+            assert!((comb.fundamental_hz - mains_hz).abs() < 0.01, "{comb:?}");
+            assert_eq!(d.verdict, Verdict::Stable, "{:?}", d.evidence);
+            let blind = detect(&stable, &off).unwrap();
+            assert_eq!(blind.verdict, Verdict::Chatter, "{:?}", blind.evidence);
+            let chatter = built_record(Some(1234.5), Some((mains_hz, Comb::All)), seed);
+            let d = detect(&chatter, &options).unwrap();
+            assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
+            assert!(close(d.chatter_hz.unwrap(), 1234.5, &d), "{:?}", d.evidence);
+            let comb = d.evidence.interference.unwrap();
+            assert!((comb.fundamental_hz - mains_hz).abs() < 0.01, "{comb:?}");
+        }
+        let lone = built_record(Some(1300.8), None, seed);
+        let d = detect(&lone, &options).unwrap();
+        assert!(d.evidence.interference.is_none(), "{:?}", d.evidence);
+        assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
+        assert!(close(d.chatter_hz.unwrap(), 1300.8, &d), "{:?}", d.evidence);
+        let odd = built_record(Some(1300.8), Some((50.0, Comb::Odd)), seed);
+        let d = detect(&odd, &options).unwrap();
+        let comb = d.evidence.interference.clone().unwrap();
+        eprintln!(
+            "seed {seed}, odd comb + 1300.8 Hz: {:?} at {:?} Hz, comb {:.4} Hz ({} lines)",
+            d.verdict,
+            d.chatter_hz,
+            comb.fundamental_hz,
+            comb.lines_hz.len()
+        );
+        assert!((comb.fundamental_hz - 50.0).abs() < 0.01, "{comb:?}");
+        assert!(
+            comb.lines_hz.iter().all(|f| (f - 1300.0).abs() > 5.0),
+            "{comb:?}"
+        );
+        assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
+        assert!(close(d.chatter_hz.unwrap(), 1300.8, &d), "{:?}", d.evidence);
+    }
+}
+
+/// The speed unknown (`DetectionOptions::unknown_speed`): on the built records, with and without
+/// the self-excited line and a 50.02 Hz mains comb, the fundamental estimated from the harmonic
+/// comb is the 80 Hz the records were built with (within 0.1 %), the mains comb is still found,
+/// and the verdicts are those of the records (the same as with the speed given). A record of
+/// noise has no comb: a clear error.
+#[test]
+fn unknown_speed_is_estimated_from_the_harmonic_comb() {
+    let options = DetectionOptions::unknown_speed();
+    for seed in 0..3 {
+        for mains in [None, Some((50.02, Comb::All))] {
+            for chatter_hz in [None, Some(1234.5)] {
+                let d = detect(&built_record(chatter_hz, mains, seed), &options).unwrap();
+                let e = &d.evidence;
+                eprintln!(
+                    "seed {seed}, mains {mains:?}, chatter {chatter_hz:?}: f0 {:.4} Hz, {:?} \
+                     at {:?} Hz, comb {:?}",
+                    e.fundamental_hz,
+                    d.verdict,
+                    d.chatter_hz,
+                    e.interference.as_ref().map(|c| c.fundamental_hz)
+                );
+                assert!((e.fundamental_hz / 80.0 - 1.0).abs() < 1e-3, "{e:?}");
+                let comb = e.interference.as_ref().map(|c| c.fundamental_hz);
+                assert_eq!(comb.is_some(), mains.is_some(), "{e:?}");
+                assert!(comb.is_none_or(|f| (f - 50.02).abs() < 0.01), "{e:?}");
+                match chatter_hz {
+                    Some(f) => {
+                        assert_eq!(d.verdict, Verdict::Chatter, "{e:?}");
+                        assert!((d.chatter_hz.unwrap() - f).abs() <= e.resolution_hz);
+                    }
+                    None => assert_eq!(d.verdict, Verdict::Stable, "{e:?}"),
+                }
+            }
+        }
+    }
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let x: Vec<f64> = (0..40_000)
+        .map(|_| StandardNormal.sample(&mut rng))
+        .collect();
+    let s = Signals::new(vec!["a".into()], 10_000.0, vec![x]).unwrap();
+    let e = detect(&s, &options).unwrap_err().to_string();
+    assert!(e.contains("no harmonic comb"), "{e}");
 }
 
 /// Out of scope and bad input: pure noise is never chatter; a fundamental above the Nyquist
@@ -281,7 +464,12 @@ fn noise_is_stable_and_bad_options_are_errors() {
 
 /// The real record of a slot cut at 5000 rpm with a four-flute cutter, labelled chatter by its
 /// authors (`shared/data/real/milling_chatter_record`, MIT licence): detected as chatter, at a
-/// frequency that is neither a spindle harmonic nor a mains (50 Hz) harmonic (684 Hz).
+/// frequency that is neither a spindle harmonic nor a mains (50 Hz) harmonic (684 Hz). Its
+/// strongest non-synchronous line is 150 Hz, the third harmonic of a 50 Hz mains comb (lines at
+/// most multiples from 50 to 4600 Hz), whose share of the power varies with the chatter bursts (V 0.56): with
+/// the search off the verdict is stable. The default search finds the comb (fundamental within
+/// 0.05 Hz of 50 Hz, independent check: its lines are the multiples of 50 Hz to within 0.5 Hz);
+/// giving 50 Hz as a known fundamental gives the same verdict.
 #[test]
 fn real_record_test255_is_chatter() {
     let path = concat!(
@@ -293,27 +481,55 @@ fn real_record_test255_is_chatter() {
         return;
     }
     let s = Signals::from_csv(std::path::Path::new(path), 10_000.0).unwrap();
-    // its strongest non-synchronous line is 150 Hz, the third harmonic of a 50 Hz mains comb
-    // (150, 200, 250, 300, 1450-1600 Hz are all present), a stationary line whose share of the
-    // power varies with the chatter bursts (V 0.56): given as interference
+    let off = |f: f64, base: f64| (f - (f / base).round() * base).abs();
     let mut options = DetectionOptions::new(5000.0 / 60.0);
-    options.interference_hz = vec![50.0];
     let d = detect(&s, &options).unwrap();
+    let comb = d.evidence.interference.clone().unwrap();
     eprintln!(
-        "test255: {:?} at {:?} Hz, {:?}",
-        d.verdict, d.chatter_hz, d.evidence
+        "test255: {:?} at {:?} Hz, V {:.2}, comb {:.4} Hz with {} lines ({} of the first 12)",
+        d.verdict,
+        d.chatter_hz,
+        d.evidence.line_variation,
+        comb.fundamental_hz,
+        comb.lines_hz.len(),
+        comb.low_members
+    );
+    assert!((comb.fundamental_hz - 50.0).abs() < 0.05, "{comb:?}");
+    assert!(
+        comb.lines_hz.iter().all(|f| off(*f, 50.0) < 0.5),
+        "{comb:?}"
     );
     assert_eq!(d.verdict, Verdict::Chatter);
     let f = d.chatter_hz.unwrap();
-    let off = |base: f64| (f - (f / base).round() * base).abs();
-    assert!(off(5000.0 / 60.0) > 2.0 && off(50.0) > 2.0, "{f}");
+    assert!(off(f, 5000.0 / 60.0) > 2.0 && off(f, 50.0) > 2.0, "{f}");
+    options.interference = Interference::Known(vec![50.0]);
+    let known = detect(&s, &options).unwrap();
+    assert_eq!(known.verdict, Verdict::Chatter);
+    assert!(known.evidence.interference.is_none());
+    assert!(
+        (known.chatter_hz.unwrap() - f).abs() < 0.5,
+        "{:?}",
+        known.chatter_hz
+    );
+    options.interference = Interference::Off;
+    let blind = detect(&s, &options).unwrap();
+    assert_eq!(blind.verdict, Verdict::Stable, "{:?}", blind.evidence);
 }
 
-/// The two MP3 sound clips of the real-data folder decode (symphonia, MP3 feature): 44.1 kHz
-/// stereo, 63.2 s and 9.3 s. Their cutting conditions are not recorded, so no spindle frequency
-/// can be given and no label is asserted (see the note of the signals work).
+/// The two MP3 sound clips of the real-data folder (44.1 kHz stereo, 63.2 s and 9.3 s; labelled
+/// chatter and no chatter, cutting conditions not recorded) decode (symphonia, MP3 feature) and
+/// are judged with the speed unknown, by the criterion validated above on the built and
+/// simulated records, nothing tuned to them.
+/// - `metalcutting_nochatter8058.mp3`: the fundamental is estimated at 91.6 Hz (5496 rpm);
+///   independent check (a separate Welch spectrum, scipy): its strongest lines 91.5, 366.7,
+///   732.8, 1007.4 and 1099.5 Hz are the multiples 1, 4, 8, 11, 12 of 91.6 Hz within 0.3 Hz (a
+///   four-flute cutter's tooth passing at 366.7 Hz). Verdict stable, as labelled.
+/// - `combined_chatter6567.mp3`: **not** called chatter (the verdict is printed, not asserted).
+///   Its 1067 Hz line is present only from about 5 to 20 s (short-time spectra); the criterion
+///   judges the record's second half (31-63 s), where the clip holds a stationary background
+///   without that line, and finds V about 0.8: stable. See the signals5 note.
 #[test]
-fn real_mp3_clips_decode() {
+fn real_mp3_clips_with_the_speed_unknown() {
     let dir = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../../shared/data/real/milling_chatter_record/"
@@ -332,5 +548,23 @@ fn real_mp3_clips_decode() {
         assert_eq!(s.data.len(), 2);
         let duration = s.data[0].len() as f64 / s.sample_rate_hz;
         assert!((duration - seconds).abs() < 0.1, "{file}: {duration} s");
+        let d = detect(&s, &DetectionOptions::unknown_speed()).unwrap();
+        let e = &d.evidence;
+        eprintln!(
+            "{file}: f0 {:.3} Hz ({:.0} rpm), {:?} at {:?} Hz, line {:.1} Hz, V {:.3}, margin \
+             {:+.3}, comb {:?}",
+            e.fundamental_hz,
+            60.0 * e.fundamental_hz,
+            d.verdict,
+            d.chatter_hz,
+            e.peak_hz,
+            e.line_variation,
+            e.margin,
+            e.interference.as_ref().map(|c| c.fundamental_hz)
+        );
+        if file.contains("nochatter") {
+            assert!((e.fundamental_hz - 91.6).abs() < 0.1, "{e:?}");
+            assert_eq!(d.verdict, Verdict::Stable, "{e:?}");
+        }
     }
 }
