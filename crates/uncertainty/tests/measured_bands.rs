@@ -135,7 +135,7 @@ fn bad_inputs_are_refused() {
     assert!(FrfUncertainty::new(0.3, 0.0).is_err());
     assert!(FrfUncertainty::new(f64::NAN, 0.01).is_err());
     let lobes = zoa_lobes(&examples::schmitz_2023_milling(), &[6000.0, 7000.0, 8000.0]).unwrap();
-    let e = ensemble_offsets(&lobes, &[lobes.clone()], 2.0).unwrap_err();
+    let e = ensemble_offsets(&lobes, std::slice::from_ref(&lobes), 2.0).unwrap_err();
     assert!(e.to_string().contains("at least 2"), "{e}");
     let e = ensemble_offsets(&lobes, &[lobes.clone(), lobes[..2].to_vec()], 2.0).unwrap_err();
     assert!(e.to_string().contains("same speeds"), "{e}");
