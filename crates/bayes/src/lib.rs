@@ -3,7 +3,7 @@
 //!
 //! | module | holds | source |
 //! |---|---|---|
-//! | [`prior`] | uniform, normal, truncated normal, lognormal marginals; independent joints | |
+//! | [`prior`] | uniform, normal, truncated normal, lognormal marginals; independent joints; the correlated multivariate normal (from mean and covariance or from samples) | |
 //! | [`samples`] | weighted sample sets: mean, covariance, quantiles, effective sample size | |
 //! | [`tmcmc`] | TMCMC / iTMCMC with the log-evidence ln p(D), data fit and information gain, model-class probabilities | Ching and Chen 2007; Betz, Papaioannou and Straub 2016; 000 Eq. 32-33 |
 //! | [`rejection`] | rejection sampling: keep theta with probability L / L_max | 004 Section 4-5 |

@@ -1,4 +1,5 @@
-//! Priors: uniform, normal, truncated normal, lognormal, and independent joints of them.
+//! Priors: uniform, normal, truncated normal, lognormal, independent joints of them, and the
+//! correlated multivariate normal (given by its mean and covariance, or estimated from samples).
 
 use crate::error::{BayesError, Result};
 use rand_distr::{Distribution, StandardNormal};
@@ -218,6 +219,159 @@ impl Prior for IndependentPrior {
     }
     fn sample(&self, rng: &mut dyn rand::RngCore) -> Vec<f64> {
         self.marginals.iter().map(|m| m.sample(rng)).collect()
+    }
+}
+
+/// Multivariate normal N(mu, Sigma): a correlated prior, e.g. one estimated from an ensemble of
+/// fitted parameter vectors. ln p(x) = -1/2 |L^-1 (x - mu)|^2 - d/2 ln(2 pi) - sum ln L_ii with
+/// the Cholesky factor Sigma = L L^T; a draw is mu + L z, z ~ N(0, I).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MultivariateNormalPrior {
+    mean: Vec<f64>,
+    covariance: nalgebra::DMatrix<f64>,
+    cholesky: nalgebra::DMatrix<f64>,
+    ln_normalization: f64,
+}
+
+/// Largest relative asymmetry |S_ij - S_ji| / sqrt(S_ii S_jj) of a covariance accepted as
+/// rounding (a covariance written to a file with 15 digits and read back).
+const SYMMETRY_TOLERANCE: f64 = 1e-9;
+
+impl MultivariateNormalPrior {
+    /// Validated: `mean` non-empty and finite, `covariance` d x d (rows), finite, symmetric to
+    /// rounding and positive definite.
+    pub fn new(mean: Vec<f64>, covariance: &[Vec<f64>]) -> Result<Self> {
+        let d = mean.len();
+        let invalid =
+            |field: &'static str, message: String| BayesError::InvalidInput { field, message };
+        if d == 0 {
+            return Err(invalid("mean", "no parameters".into()));
+        }
+        if let Some((i, v)) = mean.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(invalid(
+                "mean",
+                format!("entry {i} is {v}; expected a finite mean"),
+            ));
+        }
+        if covariance.len() != d || covariance.iter().any(|r| r.len() != d) {
+            let rows: Vec<usize> = covariance.iter().map(Vec::len).collect();
+            return Err(invalid(
+                "covariance",
+                format!("row lengths {rows:?}; expected {d} rows of {d} (the mean's dimension)"),
+            ));
+        }
+        let c = nalgebra::DMatrix::from_fn(d, d, |i, j| covariance[i][j]);
+        for i in 0..d {
+            for j in 0..d {
+                let v = c[(i, j)];
+                let scale = (c[(i, i)] * c[(j, j)]).abs().sqrt();
+                if !v.is_finite() || (v - c[(j, i)]).abs() > SYMMETRY_TOLERANCE * scale {
+                    return Err(invalid(
+                        "covariance",
+                        format!(
+                            "entry ({i}, {j}) is {v}, entry ({j}, {i}) {}; expected a finite symmetric matrix",
+                            c[(j, i)]
+                        ),
+                    ));
+                }
+            }
+        }
+        let symmetric = (&c + c.transpose()) * 0.5;
+        let Some(chol) = symmetric.clone().cholesky() else {
+            return Err(invalid(
+                "covariance",
+                "not positive definite; expected a covariance with positive variances and correlations inside (-1, 1)".into(),
+            ));
+        };
+        let l = chol.l();
+        let ln_det_half: f64 = (0..d).map(|i| l[(i, i)].ln()).sum();
+        Ok(Self {
+            mean,
+            covariance: symmetric,
+            cholesky: l,
+            ln_normalization: -0.5 * d as f64 * (2.0 * PI).ln() - ln_det_half,
+        })
+    }
+
+    /// The sample mean and covariance (divisor n - 1) of `samples`: at least d + 1 vectors of
+    /// one dimension d, spanning all d directions.
+    pub fn from_samples(samples: &[Vec<f64>]) -> Result<Self> {
+        let d = samples.first().map_or(0, Vec::len);
+        if d == 0 || samples.len() < d + 1 {
+            return Err(BayesError::InvalidInput {
+                field: "samples",
+                message: format!(
+                    "{} samples of dimension {d}; expected at least dimension + 1 samples of a dimension >= 1",
+                    samples.len()
+                ),
+            });
+        }
+        if let Some(i) = samples.iter().position(|s| s.len() != d) {
+            return Err(BayesError::InvalidInput {
+                field: "samples",
+                message: format!("sample {i} has {} entries, sample 0 {d}", samples[i].len()),
+            });
+        }
+        let n = samples.len() as f64;
+        let mean: Vec<f64> = (0..d)
+            .map(|j| samples.iter().map(|s| s[j]).sum::<f64>() / n)
+            .collect();
+        let covariance: Vec<Vec<f64>> = (0..d)
+            .map(|i| {
+                (0..d)
+                    .map(|j| {
+                        samples
+                            .iter()
+                            .map(|s| (s[i] - mean[i]) * (s[j] - mean[j]))
+                            .sum::<f64>()
+                            / (n - 1.0)
+                    })
+                    .collect()
+            })
+            .collect();
+        Self::new(mean, &covariance)
+    }
+
+    /// The mean mu.
+    pub fn mean(&self) -> &[f64] {
+        &self.mean
+    }
+
+    /// The covariance Sigma.
+    pub fn covariance(&self) -> &nalgebra::DMatrix<f64> {
+        &self.covariance
+    }
+}
+
+impl Prior for MultivariateNormalPrior {
+    fn dimension(&self) -> usize {
+        self.mean.len()
+    }
+    fn ln_pdf(&self, theta: &[f64]) -> f64 {
+        if theta.len() != self.mean.len() || theta.iter().any(|v| !v.is_finite()) {
+            return f64::NEG_INFINITY;
+        }
+        let r = nalgebra::DVector::from_iterator(
+            theta.len(),
+            theta.iter().zip(&self.mean).map(|(x, m)| x - m),
+        );
+        // L y = r by forward substitution
+        match self.cholesky.solve_lower_triangular(&r) {
+            Some(y) => self.ln_normalization - 0.5 * y.norm_squared(),
+            None => f64::NEG_INFINITY,
+        }
+    }
+    fn sample(&self, rng: &mut dyn rand::RngCore) -> Vec<f64> {
+        let d = self.mean.len();
+        let z = nalgebra::DVector::from_iterator(
+            d,
+            (0..d).map(|_| {
+                let v: f64 = StandardNormal.sample(&mut *rng);
+                v
+            }),
+        );
+        let x = &self.cholesky * z;
+        self.mean.iter().zip(x.iter()).map(|(m, v)| m + v).collect()
     }
 }
 

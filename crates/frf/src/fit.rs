@@ -23,6 +23,15 @@
 //! frequency and `damping_tolerance` in damping ratio. Stable poles are clustered by frequency;
 //! a cluster seen in at least `min_share` of the orders is a physical mode (or the `modes` most
 //! frequent clusters when the count is given), represented by its median frequency and damping.
+//!
+//! # Modes beyond the diagram
+//! Without a given count, less frequent clusters, then trial modes at the largest smoothed
+//! residual, are added one at a time; a trial is kept when, after the nonlinear refinement,
+//! it cuts the misfit by at least 5 % and every mode is still a resonance inside the band
+//! (damping ratio at most 0.15). A place whose trial fails is not tried again, so a failed trial
+//! (for example a mode just outside the band that wants to move out of it) does not end the
+//! search. A mode close outside the band is fitted best by widening the band to include it:
+//! residual terms stand for modes far from the band only.
 
 use crate::error::{FrfError, Result};
 use crate::frf::Frf;
@@ -35,8 +44,11 @@ type Candidate = (f64, f64, f64);
 
 /// Clusters seen in fewer orders than this share are never added as modes.
 const MIN_SPARE_SHARE: f64 = 0.1;
-/// Most modes added where the fit misses most.
-const MAX_RESIDUAL_MODES: usize = 4;
+/// Most trial modes placed where the fit misses most.
+const MAX_RESIDUAL_MODES: usize = 8;
+/// Largest damping ratio of a mode added beyond the stabilization diagram's: a wider "mode" is
+/// the refinement fitting a smooth trend, not a resonance.
+const MAX_ADDED_DAMPING: f64 = 0.15;
 /// Most clusters tried beyond those that pass `min_share`.
 const MAX_SPARE_TRIALS: usize = 12;
 
@@ -556,6 +568,11 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
                 .collect();
             misfit_vector(x, &h, &poles, residual_columns).map_or(f64::INFINITY, |r| r.norm())
         };
+        // an added mode must stay a resonance inside the band after refinement
+        let physical = |c: &[Candidate]| {
+            c.iter()
+                .all(|m| m.0 >= x[0] && m.0 <= f_hi && m.1 > 0.0 && m.1 <= MAX_ADDED_DAMPING)
+        };
         let mut current = misfit(&chosen);
         for cand in spare
             .iter()
@@ -572,12 +589,14 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             trial.push(*cand);
             let trial = refined(&trial);
             let m = misfit(&trial);
-            if m < 0.95 * current {
+            if physical(&trial) && m < 0.95 * current {
                 chosen = trial;
                 current = m;
             }
         }
-        // then modes where the fit misses most (a mode the diagram did not stabilize)
+        // then modes where the fit misses most (a mode the diagram did not stabilize); a place
+        // whose trial fails is not tried again
+        let mut tried: Vec<f64> = Vec::new();
         for _ in 0..MAX_RESIDUAL_MODES {
             let poles: Vec<Complex64> = chosen
                 .iter()
@@ -603,7 +622,8 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
                     sum -= power[lo];
                     lo += 1;
                 }
-                if sum > best.0 {
+                let fresh = tried.iter().all(|&t| (f - t).abs() > 0.02 * t);
+                if fresh && sum > best.0 {
                     best = (sum, f);
                 }
             }
@@ -611,11 +631,11 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             trial.push((best.1, 0.03, 0.0));
             let trial = refined(&trial);
             let m = misfit(&trial);
-            if m < 0.95 * current {
+            if physical(&trial) && m < 0.95 * current {
                 chosen = trial;
                 current = m;
             } else {
-                break;
+                tried.push(best.1);
             }
         }
     }

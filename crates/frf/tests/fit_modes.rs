@@ -1,6 +1,6 @@
 //! Modal fitting: a synthetic three-mode FRF with 2 % noise (frequencies within 0.5 %, damping
-//! within 10 %, stiffness within 5 %), the real tap-test tip FRF within 8 % relative misfit over
-//! 300-3500 Hz (5 % asked), and the H1 FRF of the raw hammer record against the measured point 1.
+//! within 10 %, stiffness within 5 %), the real tap-test tip FRF within 5 % relative misfit over
+//! 300-3500 Hz, and the H1 FRF of the raw hammer record against the measured point 1.
 
 #![allow(clippy::unwrap_used)]
 
@@ -75,13 +75,18 @@ fn synthetic_three_modes_with_two_percent_noise() {
 }
 
 #[test]
-fn real_tap_test_tip_frf_fitted_within_eight_percent() {
+fn real_tap_test_tip_frf_fitted_within_five_percent() {
     let Some(p) = real("tap_test_tool_holder/ExperimentalModalAnalysis_Point_1_Channel_1_CH1.txt")
     else {
         return;
     };
     let frf = read_frf(&p, None).unwrap();
-    let fit = fit_modes(&frf, 300.0, 3500.0, &FitOptions::default()).unwrap();
+    // the band widened to the modes just outside 300-3500 Hz (near 290 and 3890 Hz), which
+    // residual terms cannot stand for so close to the band's edges
+    let fit = fit_modes(&frf, 250.0, 4000.0, &FitOptions::default()).unwrap();
+    let misfit = frf
+        .relative_misfit(|f| Some(fit.receptance(f)), 300.0, 3500.0)
+        .unwrap();
     for m in &fit.modes {
         eprintln!(
             "{:.1} Hz zeta {:.4} k {:?} share {:.2}",
@@ -89,13 +94,14 @@ fn real_tap_test_tip_frf_fitted_within_eight_percent() {
         );
     }
     eprintln!(
-        "tap test point 1: {} modes, relative misfit {:.4} (complex modes + residuals), {:.4} (real modes only)",
+        "tap test point 1, fitted over 250-4000 Hz: {} modes, relative misfit {:.4} over 300-3500 Hz \
+         ({:.4} over the fitted band; complex modes + residuals), {:.4} (real modes only)",
         fit.modes.len(),
+        misfit,
         fit.relative_misfit,
         fit.real_mode_relative_misfit
     );
-    // the issue asks for 5 %; this fit reaches about 7 % (see the note), the test holds it there
-    assert!(fit.relative_misfit < 0.08, "{}", fit.relative_misfit);
+    assert!(misfit < 0.05, "{misfit}");
     let dominant = fit
         .modes
         .iter()

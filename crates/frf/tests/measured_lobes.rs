@@ -1,6 +1,6 @@
-//! Zero-order lobes straight from measured FRFs: a sampled modal FRF gives the modal lobes,
-//! the same FRF through a UFF 58 file and a `measured_frf` model file gives identical lobes, and
-//! the CutPro tool-tip FRFs give lobes with the process stated beside them.
+//! Zero-order lobes straight from measured FRFs: a sampled modal FRF gives the modal lobes, and
+//! the same FRF through a UFF 58 file and a `measured_frf` model file gives identical lobes (the
+//! CutPro files' lobes are in `cutpro_lobes.rs`).
 
 #![allow(clippy::unwrap_used)]
 
@@ -9,8 +9,6 @@ use chatter_frf::uff::{Uff58Record, write_uff58};
 use chatter_frf::{Frf, MeasuredModel};
 use chatter_stability::zero_order::{ZeroOrderOptions, measured_limiting_depths, zoa_lobes};
 
-mod common;
-use common::real;
 use std::path::{Path, PathBuf};
 
 /// Write the model's xx, yy and xy FRFs as one UFF 58 file and a model file naming them.
@@ -113,68 +111,4 @@ fn uff58_round_trip_gives_identical_lobes_and_the_modal_lobes() {
             "measured vs modal zero-order lobes: {worst_modal}"
         );
     }
-}
-
-#[test]
-fn real_cutpro_frfs_give_lobes_with_the_stated_process() {
-    let (Some(x), Some(y)) = (
-        real("cutpro_frf/General_FRFX.frf"),
-        real("cutpro_frf/General_FRFY.frf"),
-    ) else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
-    let text = format!(
-        r#"{{"name": "CutPro General_FRFX/Y",
-            "operation": {{"kind": "milling", "teeth": 2, "radial_immersion": 0.5, "direction": "down", "tool_diameter_mm": 31.75}},
-            "cutting": {{"kt_n_per_mm2": 1319.4, "kn_n_per_mm2": 788.8}},
-            "measured_frf": [{{"file": {x:?}, "direction": "x", "fmin_hz": 10}}, {{"file": {y:?}, "direction": "y", "fmin_hz": 10}}]}}"#
-    );
-    let path = dir.path().join("cutpro.json");
-    std::fs::write(&path, text).unwrap();
-    let m = MeasuredModel::from_path(&path).unwrap();
-    let speeds: Vec<f64> = (0..400).map(|i| 3000.0 + 50.0 * i as f64).collect();
-    let lobes = measured_limiting_depths(
-        &m.operation,
-        m.cutting,
-        &m.receptance,
-        &speeds,
-        &ZeroOrderOptions::unbounded(),
-    )
-    .unwrap();
-    let min = lobes
-        .iter()
-        .min_by(|a, b| a.depth_m.total_cmp(&b.depth_m))
-        .unwrap();
-    // the stiffness-form approximation stated with the files, for scale
-    let approx: ModalModel = ModalModel::from_json_str(
-        r#"{"operation": {"kind": "milling", "teeth": 2, "radial_immersion": 0.5, "direction": "down"},
-            "cutting": {"kt_n_per_mm2": 1319.4, "kn_n_per_mm2": 788.8},
-            "modes": [{"frequency_hz": 456.78, "damping_ratio": 0.1117, "stiffness_n_per_m": 7.933e6, "direction": "x"},
-                      {"frequency_hz": 1448.89, "damping_ratio": 0.01704, "stiffness_n_per_m": 1.469e7, "direction": "x"},
-                      {"frequency_hz": 516.52, "damping_ratio": 0.02458, "stiffness_n_per_m": 9.375e6, "direction": "y"},
-                      {"frequency_hz": 1408.45, "damping_ratio": 0.03136, "stiffness_n_per_m": 1.241e7, "direction": "y"}]}"#,
-        Path::new("approx.json"),
-    ).unwrap();
-    let approx_lobes = zoa_lobes(&approx, &speeds).unwrap();
-    let approx_min = approx_lobes
-        .iter()
-        .map(|l| l.depth_m)
-        .fold(f64::INFINITY, f64::min);
-    eprintln!(
-        "CutPro General_FRFX/Y: minimum depth {:.3} mm at {:.0} rpm, chatter {:.0} Hz; stiffness form {:.3} mm",
-        min.depth_mm(),
-        min.speed_rpm,
-        min.chatter_hz,
-        approx_min * 1e3
-    );
-    assert!(lobes.iter().all(|l| l.depth_m > 0.0));
-    assert!(min.depth_m.is_finite() && min.chatter_hz > 300.0 && min.chatter_hz < 1700.0);
-    // same order as the stiffness form (which misses the FRF by about 21 %)
-    assert!(
-        min.depth_m / approx_min > 0.5 && min.depth_m / approx_min < 2.0,
-        "{} vs {}",
-        min.depth_m,
-        approx_min
-    );
 }

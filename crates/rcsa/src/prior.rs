@@ -176,6 +176,20 @@ pub fn rcsa_prior(assembly: &Assembly, settings: &PriorSettings) -> Result<Modal
 }
 
 impl ModalPrior {
+    /// The prior as the samplers take it: [`chatter_bayes::prior::MultivariateNormalPrior`] over
+    /// u, an error where the covariance is not positive definite (too few FRFs for 8 parameters).
+    pub fn bayes_prior(&self) -> Result<chatter_bayes::prior::MultivariateNormalPrior> {
+        let cov: Vec<Vec<f64>> = (0..self.mean.len())
+            .map(|i| {
+                (0..self.mean.len())
+                    .map(|j| self.covariance[(i, j)])
+                    .collect()
+            })
+            .collect();
+        chatter_bayes::prior::MultivariateNormalPrior::new(self.mean.clone(), &cov)
+            .map_err(|e| RcsaError::value("prior covariance", f64::NAN, e.to_string()))
+    }
+
     /// The prior file: `{"parameter_names": [...], "mean": [...], "covariance": [[...]]}`.
     pub fn to_json(&self) -> serde_json::Value {
         let cov: Vec<Vec<f64>> = (0..8)

@@ -4,6 +4,7 @@
 //! of the mean parameters.
 #![allow(clippy::unwrap_used)]
 
+use chatter_bayes::prior::Prior;
 use chatter_rcsa::Assembly;
 use chatter_rcsa::prior::{
     PriorSettings, model_of, prior_boundaries, rcsa_prior, three_flute_milling,
@@ -20,6 +21,12 @@ fn prior_map_is_monotone_and_centred_on_the_mean_boundary() {
     };
     let prior = rcsa_prior(&assembly, &settings).unwrap();
     assert!(prior.covariance.clone().cholesky().is_some());
+    // the samplers' form of it: the same mean, densest at the mean
+    let bayes = prior.bayes_prior().unwrap();
+    assert_eq!(bayes.mean(), prior.mean.as_slice());
+    let mut off = prior.mean.clone();
+    off[2] += prior.covariance[(2, 2)].sqrt();
+    assert!(bayes.ln_pdf(&prior.mean) > bayes.ln_pdf(&off));
     // seeded: the same prior again
     assert_eq!(prior, rcsa_prior(&assembly, &settings).unwrap());
     // the first mode's frequency rises with the joint stiffness: its correlation with the

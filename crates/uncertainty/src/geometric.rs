@@ -59,6 +59,16 @@ impl TypeBOffsets {
         })
     }
 
+    /// The speed offset o_Omega (rpm).
+    pub fn offset_rpm(&self) -> f64 {
+        self.offset_rpm
+    }
+
+    /// The depth offset o_b (mm).
+    pub fn offset_mm(&self) -> f64 {
+        self.offset_mm
+    }
+
     /// Eq. 1: the offset distance (rpm / um units) for a boundary angle `theta_rad`.
     pub fn distance(&self, theta_rad: f64) -> f64 {
         let ob = self.offset_mm * DEPTH_SCALE_UM_PER_MM;
