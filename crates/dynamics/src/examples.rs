@@ -4,7 +4,7 @@
 
 use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
 use crate::observations::Observations;
-use crate::operation::{Milling, MillingDirection, Operation};
+use crate::operation::{Milling, MillingDirection, Operation, Turning};
 use std::path::Path;
 
 /// Model file of the turning case of Ahmadi (2022), seed 000, Table 1.
@@ -131,4 +131,37 @@ pub fn process_damping_flexure(c_n_per_m: Option<f64>) -> ModalModel {
         )
     };
     build().unwrap_or_else(|e| panic!("003-like flexure with C = {c_n_per_m:?}: {e}"))
+}
+
+/// The gap proving ground's lathe: a 640 Hz feed mode (damping ratio 0.03, 2.5e7 N/m) and a
+/// 700 Hz mode at 30 degrees (0.035, 3e7 N/m), a 50 mm workpiece, kt 1500 and kn 600 N/mm^2,
+/// and the process-damping coefficient `c_n_per_m` (N/m). With C about 1e6 N/m and more, slow
+/// surface regeneration dominates at low speed and the multipliers cluster near one modulus.
+pub fn proving_ground_lathe(c_n_per_m: Option<f64>) -> ModalModel {
+    let build = || -> crate::Result<ModalModel> {
+        let feed = Mode::new(
+            640.0,
+            0.03,
+            ModeShape::Directional {
+                coordinate: 0,
+                stiffness_n_per_m: 2.5e7,
+            },
+        )?;
+        // mass-normalized shape of a 3e7 N/m mode at 30 degrees: |phi| = omega / sqrt(k)
+        let a = 2.0 * std::f64::consts::PI * 700.0 / 3e7f64.sqrt();
+        let t = 30f64.to_radians();
+        let oblique = Mode::new(
+            700.0,
+            0.035,
+            ModeShape::MassNormalized([a * t.cos(), a * t.sin()]),
+        )?;
+        ModalModel::new(
+            Some("gap proving-ground lathe".into()),
+            Operation::Turning(Turning::new(Some(0.05))?),
+            CuttingCoefficients::new(1500e6, 600e6)?,
+            vec![feed, oblique],
+            c_n_per_m,
+        )
+    };
+    build().unwrap_or_else(|e| panic!("proving-ground lathe with C = {c_n_per_m:?}: {e}"))
 }

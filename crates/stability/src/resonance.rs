@@ -215,38 +215,13 @@ mod tests {
     use super::*;
     use chatter_dynamics::examples;
 
-    /// A lathe (one 640 Hz mode, 2.5e7 N/m, 50 mm workpiece, K 1500 N/mm^2) with strong process
-    /// damping (C 1.76e6 N/m, the gap proving ground's 2x case): at 1200 rpm and 15-30 mm the
-    /// dominant multiplier is the real root.
-    fn damped_lathe() -> ModalModel {
-        use chatter_dynamics::{CuttingCoefficients, Mode, ModeShape, Operation, Turning};
-        let mode = Mode::new(
-            640.0,
-            0.03,
-            ModeShape::Directional {
-                coordinate: 0,
-                stiffness_n_per_m: 2.5e7,
-            },
-        )
-        .unwrap();
-        ModalModel::new(
-            None,
-            Operation::Turning(Turning::new(Some(0.05)).unwrap()),
-            CuttingCoefficients::new(1500e6, 600e6).unwrap(),
-            vec![mode],
-            None,
-        )
-        .unwrap()
-        .with_process_damping(Some(1.76e6))
-        .unwrap()
-    }
-
     /// Against the dense eigenvalues: the largest eigenvalue away from the harmonics, an
     /// eigenvector of the undeflated operator (residual 1e-8), and a real dominant multiplier
     /// deflated in at least one case.
     #[test]
     fn deflation_finds_the_largest_eigenvalue_off_the_harmonics() {
-        let lathe = damped_lathe();
+        // the proving ground's lathe with the process damping of its 2x case
+        let lathe = examples::proving_ground_lathe(Some(1.76e6));
         let flexure = examples::process_damping_flexure(Some(2.5e5));
         let mut deflated = 0;
         for (model, rpm, depth_m) in [

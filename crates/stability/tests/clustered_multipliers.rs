@@ -6,44 +6,11 @@
 
 #![allow(clippy::unwrap_used)]
 
-use chatter_dynamics::{
-    CuttingCoefficients, ModalModel, Mode, ModeShape, Operation, Turning, examples,
-};
+use chatter_dynamics::{ModalModel, examples};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::frequency_domain::FrequencyDomain;
 use chatter_stability::monodromy::Discretization;
-use std::f64::consts::PI;
-
-/// The gap proving ground's lathe (a 640 Hz feed mode and a 700 Hz mode at 30 degrees, 50 mm
-/// workpiece, kt 1500 and kn 600 N/mm^2) with process damping `c_n_per_m`.
-fn proving_ground_lathe(c_n_per_m: Option<f64>) -> ModalModel {
-    let feed = Mode::new(
-        640.0,
-        0.03,
-        ModeShape::Directional {
-            coordinate: 0,
-            stiffness_n_per_m: 2.5e7,
-        },
-    )
-    .unwrap();
-    let a = 2.0 * PI * 700.0 / 3e7f64.sqrt();
-    let t = 30f64.to_radians();
-    let oblique = Mode::new(
-        700.0,
-        0.035,
-        ModeShape::MassNormalized([a * t.cos(), a * t.sin()]),
-    )
-    .unwrap();
-    ModalModel::new(
-        None,
-        Operation::Turning(Turning::new(Some(0.05)).unwrap()),
-        CuttingCoefficients::new(1500e6, 600e6).unwrap(),
-        vec![feed, oblique],
-        c_n_per_m,
-    )
-    .unwrap()
-}
 
 /// det D(lambda) of the characteristic equation on the real axis, 2 x 2 in modal coordinates:
 /// D = lambda^2 I + 2 Z Omega lambda + Omega^2 + b W (1 - e^{-lambda tau}) + lambda b P with
@@ -85,7 +52,7 @@ fn lathe_with_process_damping_at_low_speed() {
         (1.755_891e6, 0.015),
         (1.755_891e6, 0.02),
     ] {
-        let model = proving_ground_lathe(Some(c));
+        let model = examples::proving_ground_lathe(Some(c));
         let tau = model.operation().delay_s(speed);
         // bisection for the largest real root: det D > 0 at lambda = 0 (static stiffness) and
         // changes sign at the quasi-static root
@@ -178,7 +145,7 @@ fn flexure_at_300_rpm_matches_dense_eigenvalues() {
 /// limiting depth.
 #[test]
 fn dominant_root_survives_a_failed_continuation() {
-    let model = proving_ground_lathe(None);
+    let model = examples::proving_ground_lathe(None);
     let speed = 2300.0;
     let fdm = Discretization::full().with_steps(4000);
     let limit = limiting_depth(&fdm, &model, speed, &BoundaryOptions::default())
