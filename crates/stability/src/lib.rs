@@ -19,6 +19,7 @@ pub mod prepared;
 pub mod process_damping;
 mod root;
 pub mod sensitivity;
+mod step;
 pub mod zero_order;
 
 pub use error::{Result, StabilityError};

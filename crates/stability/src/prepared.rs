@@ -39,7 +39,7 @@ use crate::boundary::{
 };
 use crate::error::{Result, StabilityError};
 use crate::frequency_domain::FrequencyDomain;
-use crate::monodromy::{Discretization, StepsPerDelay};
+use crate::monodromy::{Discretization, Monodromy, StepPlan, StepsPerDelay};
 use crate::multiplier::DominantMultiplier;
 use crate::zero_order::{PreparedZeroOrder, ZeroOrderOptions};
 use chatter_dynamics::{ModalModel, Operation};
@@ -318,10 +318,7 @@ impl PreparedSolver for PreparedDiscretization {
     /// may put the other lobe lowest, and the dominant lobe alone is extrapolated.
     fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
         let coarse = self.at_speed(speed_rpm)?;
-        let solver = WarmStarted {
-            discretization: coarse,
-            start: Mutex::new(None),
-        };
+        let solver = WarmStarted::new(&coarse, &self.model, speed_rpm, None)?;
         let guess_m = guess(self.guide.as_ref(), speed_rpm);
         let Some(fine) = self.finer(&coarse) else {
             return limiting_depth_near(&solver, &self.model, speed_rpm, guess_m, &self.options);
@@ -344,10 +341,7 @@ impl PreparedSolver for PreparedDiscretization {
             .into_inner()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
             .map(|v| prolonged(&v, self.model.mode_count()));
-        let fine = WarmStarted {
-            discretization: fine,
-            start: Mutex::new(start),
-        };
+        let fine = WarmStarted::new(&fine, &self.model, speed_rpm, start)?;
         let (mu, chatter_hz) = fine.chatter_frequency_hz(&self.model, speed_rpm, coarse_depth)?;
         let g = mu.modulus() - 1.0;
         let mut fine_depth = coarse_depth - g / slope;
@@ -411,26 +405,50 @@ fn prolonged(coarse: &[f64], modes: usize) -> Vec<f64> {
     v
 }
 
-/// A discretization whose Arnoldi runs start from the eigenvector of the previous call: along
-/// one boundary search the operators differ only in depth and share their dimension, so the
-/// previous eigenvector is a close start (the result is the same to the Arnoldi tolerance).
+/// A discretization at one speed whose Krylov runs start from the eigenvector of the previous
+/// call: along one boundary search the operators differ only in depth and share their dimension,
+/// so the previous eigenvector is a close start (the result is the same to the Krylov
+/// tolerance). The depth-independent part of the step program is built once ([`StepPlan`]).
 struct WarmStarted {
-    discretization: Discretization,
+    plan: StepPlan,
+    speed_rpm: f64,
     start: Mutex<Option<Vec<f64>>>,
+}
+
+impl WarmStarted {
+    /// The plan of `discretization` for `model` at `speed_rpm`, started from `start`.
+    fn new(
+        discretization: &Discretization,
+        model: &ModalModel,
+        speed_rpm: f64,
+        start: Option<Vec<f64>>,
+    ) -> Result<Self> {
+        Ok(Self {
+            plan: discretization.plan(model, speed_rpm)?,
+            speed_rpm,
+            start: Mutex::new(start),
+        })
+    }
+
+    /// The operator at `depth_m`; the plan's speed is the only one this solver answers for.
+    fn monodromy(&self, speed_rpm: f64, depth_m: f64) -> Result<Monodromy> {
+        debug_assert_eq!(speed_rpm, self.speed_rpm);
+        self.plan.monodromy(depth_m)
+    }
 }
 
 impl StabilitySolver for WarmStarted {
     fn name(&self) -> &'static str {
-        self.discretization.name()
+        self.plan.scheme().name()
     }
 
     fn dominant_multiplier(
         &self,
-        model: &ModalModel,
+        _model: &ModalModel,
         speed_rpm: f64,
         depth_m: f64,
     ) -> Result<DominantMultiplier> {
-        let op = self.discretization.monodromy(model, speed_rpm, depth_m)?;
+        let op = self.monodromy(speed_rpm, depth_m)?;
         let mut start = self
             .start
             .lock()
@@ -446,12 +464,12 @@ impl StabilitySolver for WarmStarted {
         speed_rpm: f64,
         depth_m: f64,
     ) -> Result<(DominantMultiplier, f64)> {
+        let op = self.monodromy(speed_rpm, depth_m)?;
         let start = self
             .start
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        self.discretization
-            .chatter_frequency_from(model, speed_rpm, depth_m, start.as_deref())
+        op.chatter_frequency_from(model, start.as_deref())
     }
 }
 
