@@ -322,11 +322,10 @@ pub(crate) fn krylov_schur<F: Fn(&[f64], &mut [f64])>(
             .map(|i| 1.0 + 0.5 * ((i as f64) * config.start_phase).sin())
             .collect(),
     };
-    let mut basis = vec![vec![0.0; d]; m + 1];
+    // the basis grows as the cycles need it (most operators converge with a few vectors)
+    let mut basis: Vec<Vec<f64>> = Vec::with_capacity(m + 1);
     let norm = start.iter().map(|x| x * x).sum::<f64>().sqrt();
-    for (vi, si) in basis[0].iter_mut().zip(&start) {
-        *vi = si / norm;
-    }
+    basis.push(start.iter().map(|si| si / norm).collect());
     // projected matrix: columns 0..kk of the decomposition A V_kk = V_kk+1 b[0..kk+1, 0..kk]
     let mut b = DMatrix::<f64>::zeros(m + 1, m);
     let mut kept = 0;
@@ -363,6 +362,9 @@ pub(crate) fn krylov_schur<F: Fn(&[f64], &mut [f64])>(
             b[(j + 1, j)] = beta;
             let kk = j + 1;
             let breakdown = beta < 1e-14 || beta <= KRYLOV_BREAKDOWN * image2.sqrt();
+            if basis.len() == j + 1 {
+                basis.push(vec![0.0; d]);
+            }
             if !breakdown {
                 for (vx, wx) in basis[j + 1].iter_mut().zip(&w) {
                     *vx = wx / beta;

@@ -498,32 +498,30 @@ impl Monodromy {
         let ft = 1.0 / self.period_s;
         let k_max = (band_hz.1 / ft).ceil() as i32 + 1;
         let candidates = multiplier.frequency_family_hz(0..=k_max);
-        let mut times = Vec::with_capacity(self.grid);
-        let mut t = 0.0;
-        for &h in &self.step_s {
-            times.push(t);
-            t += h;
-        }
         candidates
             .into_iter()
             .filter(|f| *f >= band_hz.0 && *f <= band_hz.1)
             .map(|f| {
-                // |V(f)|^2 + |V(-f)|^2: the same for the eigenvector of either member of a
-                // complex-conjugate pair of multipliers
-                let amplitude: f64 = (0..n)
-                    .flat_map(|j| [(j, f), (j, -f)])
-                    .map(|(j, f)| {
-                        let sum: Complex64 = (0..self.grid)
-                            .map(|k| {
-                                let phase = -2.0 * PI * f * times[k];
-                                vector[s2 + k * n + j]
-                                    * Complex64::new(phase.cos(), phase.sin())
-                                    * self.step_s[k]
-                            })
-                            .sum();
-                        sum.norm_sqr()
-                    })
-                    .sum();
+                // V_j(f) = sum_k v_jk e^{-2 pi i f t_k} h_k, the phasor advanced step by step
+                // (a new rotation only where the step length changes); |V(f)|^2 + |V(-f)|^2 is
+                // the same for the eigenvector of either member of a conjugate pair
+                let mut plus = vec![Complex64::new(0.0, 0.0); n];
+                let mut minus = vec![Complex64::new(0.0, 0.0); n];
+                let mut phasor = Complex64::new(1.0, 0.0);
+                let mut rotation = (f64::NAN, phasor);
+                for (k, &h) in self.step_s.iter().enumerate() {
+                    let weight = phasor * h;
+                    for (j, (p, m)) in plus.iter_mut().zip(minus.iter_mut()).enumerate() {
+                        let v = vector[s2 + k * n + j];
+                        *p += v * weight;
+                        *m += v * weight.conj();
+                    }
+                    if h != rotation.0 {
+                        rotation = (h, Complex64::from_polar(1.0, -2.0 * PI * f * h));
+                    }
+                    phasor *= rotation.1;
+                }
+                let amplitude: f64 = plus.iter().chain(&minus).map(|z| z.norm_sqr()).sum();
                 (f, amplitude)
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))
