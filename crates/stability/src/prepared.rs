@@ -235,7 +235,10 @@ impl PreparedDiscretization {
             .resolved(self.grid.as_ref().unwrap_or(&self.model), speed_rpm)?;
         let refined = self.discretization.steps == StepsPerDelay::Auto
             && self.discretization.scheme == Scheme::Semi
-            && self.model.process_damping_n_per_m().is_some_and(|c| c > 0.0);
+            && self
+                .model
+                .process_damping_n_per_m()
+                .is_some_and(|c| c > 0.0);
         Ok(match resolved.steps {
             StepsPerDelay::Fixed(m) if refined => {
                 resolved.with_steps(SEMI_PROCESS_DAMPING_REFINEMENT * m)

@@ -143,7 +143,10 @@ fn discretizations_with_process_damping_match_time_domain() {
                 limit.depth_mm()
             );
             for solver in [&fdm, &sdm] {
-                let discretized = solver.dominant_multiplier(&model, speed, b).unwrap().modulus();
+                let discretized = solver
+                    .dominant_multiplier(&model, speed, b)
+                    .unwrap()
+                    .modulus();
                 assert!(
                     (direct - discretized).abs() < 1e-3,
                     "{speed} rpm, {factor} x {} mm: time domain {direct}, {} {discretized}",
