@@ -11,6 +11,7 @@ pub mod boundary;
 mod eigen;
 pub mod error;
 pub mod frequency_domain;
+mod grid;
 mod hessenberg;
 mod krylov;
 pub mod monodromy;

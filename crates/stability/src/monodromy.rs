@@ -33,15 +33,18 @@
 //! found by Krylov–Schur (Stewart 2002's thick-restart Arnoldi, in the crate's `krylov` module)
 //! on that operator; the dense matrix is built column by column in O(M^2 N^3) only when all
 //! eigenpairs are needed (sensitivities, cross-checks).
+//!
+//! Files: the grid in the crate's `grid` module, the step blocks and their depth-independent
+//! plan in `step` ([`StepPlan`]), the operator here, the eigen-solver in `krylov`.
 
 use crate::StabilitySolver;
 use crate::eigen::dense_eigenvalues;
 use crate::error::{Result, StabilityError, check_condition};
+use crate::grid::segments;
 pub use crate::krylov::DENSE_FALLBACK_MAX_DIM;
 use crate::krylov::{DENSE_MAX_DIM, largest, robust_eigenpair};
 use crate::multiplier::DominantMultiplier;
 pub use crate::step::StepPlan;
-use crate::step::segments;
 use chatter_dynamics::ModalModel;
 use nalgebra::DMatrix;
 use num_complex::Complex64;

@@ -1,4 +1,5 @@
-//! The grid and the steps of the discretizations (see [`crate::monodromy`] for the equations):
+//! The steps of the discretizations (see [`crate::monodromy`] for the equations; the grid is in
+//! the crate's `grid` module):
 //! the depth-independent part of a step program at one speed, prepared once ([`StepPlan`]) and
 //! turned into the monodromy operator at any depth ([`StepPlan::monodromy`]).
 //!
@@ -11,41 +12,10 @@
 //! bit, as one built from scratch.
 
 use crate::error::{Result, StabilityError, check_condition};
+use crate::grid::segments;
 use crate::monodromy::{Discretization, Monodromy, Scheme, Step};
 use chatter_dynamics::{ModalModel, Operation};
 use nalgebra::DMatrix;
-use std::f64::consts::PI;
-
-/// Grid of one delay: breakpoints and whether each segment cuts. One delay tau is cut at every
-/// tooth entry and exit, so that H(t) is smooth on each segment.
-pub(crate) fn segments(model: &ModalModel, speed_rpm: f64, tau: f64) -> Vec<(f64, f64, bool)> {
-    let mut cuts = vec![0.0, tau];
-    if let Operation::Milling(m) = model.operation() {
-        let omega = 2.0 * PI * speed_rpm / 60.0;
-        let (entry, exit) = m.entry_exit_rad();
-        let teeth = m.teeth();
-        for j in 0..teeth {
-            let offset = 2.0 * PI * j as f64 / teeth as f64;
-            for angle in [entry, exit] {
-                // times in [0, tau) at which tooth j reaches `angle` (mod 2 pi)
-                let t0 = (angle - offset).rem_euclid(2.0 * PI) / omega;
-                let t = t0.rem_euclid(tau);
-                if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
-                    cuts.push(t);
-                }
-            }
-        }
-    }
-    cuts.sort_by(f64::total_cmp);
-    cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
-    cuts.windows(2)
-        .map(|w| {
-            let mid = 0.5 * (w[0] + w[1]);
-            let h = model.directional_matrix(mid, speed_rpm);
-            (w[0], w[1], h.abs().max() > 0.0)
-        })
-        .collect()
-}
 
 /// Van Loan: exp of [[A, I, 0], [0, 0, I], [0, 0, 0]] h gives e^{A h}, F_1 and F_2.
 fn exp_integrals(a: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
