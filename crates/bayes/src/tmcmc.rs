@@ -248,23 +248,7 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         let w: Vec<f64> = ln_w.iter().map(|x| (x - m).exp()).collect();
         let total: f64 = w.iter().sum();
         let weights: Vec<f64> = w.iter().map(|x| x / total).collect();
-        // weighted covariance of the current samples
-        let mut mean = DVector::zeros(d);
-        for (t, wi) in theta.iter().zip(&weights) {
-            mean += DVector::from_column_slice(t) * *wi;
-        }
-        let mut cov = DMatrix::zeros(d, d);
-        for (t, wi) in theta.iter().zip(&weights) {
-            let dv = DVector::from_column_slice(t) - &mean;
-            cov += &dv * dv.transpose() * *wi;
-        }
-        let jitter = 1e-12 * (cov.trace() / d as f64).max(1e-300);
-        let chol = (cov + DMatrix::identity(d, d) * jitter)
-            .cholesky()
-            .ok_or_else(|| {
-                BayesError::Degenerate("sample covariance is not positive definite".into())
-            })?
-            .l();
+        let chol = proposal_factor(&theta, &weights)?;
         // systematic resampling (deterministic given the weights and one uniform per stage)
         let mut rng = stream(options.seed, stage, usize::MAX);
         let u0: f64 = rand::Rng::random::<f64>(&mut rng) / n as f64;
@@ -289,36 +273,22 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         } else {
             0.2
         };
+        let chains = Chains {
+            prior,
+            likelihood,
+            factor: &chol,
+            scale: c_scale,
+            beta,
+            steps,
+            seed: options.seed,
+            stage,
+            evaluations: &evaluations,
+            failures: &failures,
+        };
         let moved: Vec<(Vec<f64>, f64, usize)> = idx
             .par_iter()
             .enumerate()
-            .map(|(chain, &start)| {
-                let mut rng = stream(options.seed, stage, chain);
-                let mut x = theta[start].clone();
-                let mut lx = ln_l[start];
-                let mut px = prior.ln_pdf(&x);
-                let mut accepted = 0;
-                for _ in 0..steps {
-                    let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
-                    let step = &chol * z * c_scale;
-                    let y: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
-                    let py = prior.ln_pdf(&y);
-                    if !py.is_finite() {
-                        continue;
-                    }
-                    evaluations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let ly = counted_ln_likelihood(likelihood, &y, &failures);
-                    let log_ratio = py + beta * ly - px - beta * lx;
-                    let u: f64 = rand::Rng::random::<f64>(&mut rng);
-                    if log_ratio >= 0.0 || u.ln() < log_ratio {
-                        x = y;
-                        lx = ly;
-                        px = py;
-                        accepted += 1;
-                    }
-                }
-                (x, lx, accepted)
-            })
+            .map(|(chain, &start)| chains.run(chain, theta[start].clone(), ln_l[start]))
             .collect();
         let acc = moved.iter().map(|m| m.2).sum::<usize>() as f64 / (n * steps) as f64;
         theta = moved.iter().map(|m| m.0.clone()).collect();
@@ -345,6 +315,131 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         evaluations: evaluations.into_inner(),
         numerical_failures: failures.into_inner(),
     })
+}
+
+/// Cholesky factor of the weighted covariance of `theta` (with a relative jitter of 1e-12): the
+/// shape of the Metropolis-Hastings proposals.
+fn proposal_factor(theta: &[Vec<f64>], weights: &[f64]) -> Result<DMatrix<f64>> {
+    let d = theta.first().map_or(0, Vec::len);
+    let mut mean = DVector::zeros(d);
+    for (t, wi) in theta.iter().zip(weights) {
+        mean += DVector::from_column_slice(t) * *wi;
+    }
+    let mut cov = DMatrix::zeros(d, d);
+    for (t, wi) in theta.iter().zip(weights) {
+        let dv = DVector::from_column_slice(t) - &mean;
+        cov += &dv * dv.transpose() * *wi;
+    }
+    let jitter = 1e-12 * (cov.trace() / d as f64).max(1e-300);
+    Ok((cov + DMatrix::identity(d, d) * jitter)
+        .cholesky()
+        .ok_or_else(|| BayesError::Degenerate("sample covariance is not positive definite".into()))?
+        .l())
+}
+
+/// Metropolis-Hastings chains on p(theta) L(theta)^beta with Gaussian proposals
+/// scale x factor x N(0, I), each chain on its own (seed, stage, chain) stream.
+struct Chains<'a, P, L> {
+    prior: &'a P,
+    likelihood: &'a L,
+    factor: &'a DMatrix<f64>,
+    scale: f64,
+    beta: f64,
+    steps: usize,
+    seed: u64,
+    stage: usize,
+    evaluations: &'a std::sync::atomic::AtomicUsize,
+    failures: &'a std::sync::atomic::AtomicUsize,
+}
+
+impl<P: Prior, L: LogLikelihood> Chains<'_, P, L> {
+    /// `steps` moves of chain `chain` from `x` (log-likelihood `lx`): the end point, its
+    /// log-likelihood and the number of accepted moves.
+    fn run(&self, chain: usize, mut x: Vec<f64>, mut lx: f64) -> (Vec<f64>, f64, usize) {
+        let d = x.len();
+        let mut rng = stream(self.seed, self.stage, chain);
+        let mut px = self.prior.ln_pdf(&x);
+        let mut accepted = 0;
+        for _ in 0..self.steps {
+            let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
+            let step = self.factor * z * self.scale;
+            let y: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+            let py = self.prior.ln_pdf(&y);
+            if !py.is_finite() {
+                continue;
+            }
+            self.evaluations
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let ly = counted_ln_likelihood(self.likelihood, &y, self.failures);
+            let log_ratio = py + self.beta * ly - px - self.beta * lx;
+            let u: f64 = rand::Rng::random::<f64>(&mut rng);
+            if log_ratio >= 0.0 || u.ln() < log_ratio {
+                x = y;
+                lx = ly;
+                px = py;
+                accepted += 1;
+            }
+        }
+        (x, lx, accepted)
+    }
+}
+
+/// More Metropolis-Hastings moves of a finished run's posterior samples (beta = 1), `rounds`
+/// rounds of `steps` steps per sample, the proposal reshaped to the samples' covariance each
+/// round and its scale moved towards acceptance 0.21 as iTMCMC does. With the small populations
+/// that expensive likelihoods allow, the final resampling leaves many copies of few points;
+/// these moves spread them over the posterior again (for a posterior predictive check, say).
+/// The log-evidence is the run's; samples, their log-likelihoods, counts, and one beta = 1 and
+/// acceptance entry per round are updated. Seeded by `seed` (stages numbered after the run's).
+pub fn rejuvenate<P: Prior, L: LogLikelihood>(
+    prior: &P,
+    likelihood: &L,
+    run: &TmcmcResult,
+    rounds: usize,
+    steps: usize,
+    seed: u64,
+) -> Result<TmcmcResult> {
+    let mut theta: Vec<Vec<f64>> = run.samples.samples().to_vec();
+    let n = theta.len();
+    let d = prior.dimension();
+    let mut ln_l = run.ln_likelihoods.clone();
+    let mut out = run.clone();
+    let evaluations = std::sync::atomic::AtomicUsize::new(0);
+    let failures = std::sync::atomic::AtomicUsize::new(0);
+    let mut scale = 2.38 / (d as f64).sqrt();
+    for round in 0..rounds {
+        let weights = vec![1.0 / n as f64; n];
+        let factor = proposal_factor(&theta, &weights)?;
+        let chains = Chains {
+            prior,
+            likelihood,
+            factor: &factor,
+            scale,
+            beta: 1.0,
+            steps,
+            seed,
+            stage: run.betas.len() + round,
+            evaluations: &evaluations,
+            failures: &failures,
+        };
+        let moved: Vec<(Vec<f64>, f64, usize)> = theta
+            .par_iter()
+            .zip(&ln_l)
+            .enumerate()
+            .map(|(chain, (x, &lx))| chains.run(chain, x.clone(), lx))
+            .collect();
+        let acc = moved.iter().map(|m| m.2).sum::<usize>() as f64 / (n * steps.max(1)) as f64;
+        theta = moved.iter().map(|m| m.0.clone()).collect();
+        ln_l = moved.iter().map(|m| m.1).collect();
+        out.acceptance.push(acc);
+        out.betas.push(1.0);
+        scale *= ((acc - 0.21) * 2.0).exp();
+    }
+    out.samples = SampleSet::equally_weighted(theta)?;
+    out.ln_likelihoods = ln_l;
+    out.evaluations += evaluations.into_inner();
+    out.numerical_failures += failures.into_inner();
+    Ok(out)
 }
 
 /// Posterior probabilities of model classes from their log-evidences (equal prior

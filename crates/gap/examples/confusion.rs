@@ -5,8 +5,9 @@
 //! (the diagnosis uses the full discretization); held-out cuts drawn from the truth measure how
 //! much of the nominal model's misclassification the diagnosed model closes.
 //!
-//! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --magnitudes 1
-//! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --verbose]`
+//! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --first-seed 0 --magnitudes 1
+//! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --sampler-offset 0
+//! --verbose]`
 
 mod common;
 
@@ -61,9 +62,17 @@ fn main() -> chatter_gap::Result<()> {
     let machines = proving_machines()?;
     let pick: Vec<usize> = list("--machines", (0..machines.len()).collect());
     let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
+    let first_seed: u64 = arg("--first-seed")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let magnitudes: Vec<f64> = list("--magnitudes", vec![0.5, 1.0, 2.0]);
     let classes: Vec<EffectClass> = list("--classes", EffectClass::ALL.to_vec());
     let verbose = std::env::args().any(|a| a == "--verbose");
+    // the samplers' seed apart from the campaign's: repeats one campaign to see the evidence's
+    // Monte Carlo scatter
+    let sampler_offset: u64 = arg("--sampler-offset")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let kinds: Vec<String> = list(
         "--cases",
         vec!["control".into(), "effects".into(), "outside".into()],
@@ -116,7 +125,7 @@ fn main() -> chatter_gap::Result<()> {
         }
         cases.retain(|(_, magnitude, _, _)| kinds.contains(&kind_of(magnitude)));
         for (name, magnitude, effect, error) in cases {
-            for seed in 0..seeds {
+            for seed in first_seed..first_seed + seeds {
                 let mut scenario = Scenario::new(effect, 1000 + seed).with_speed_range(lo, hi, 4);
                 scenario.error = error;
                 if let Some(cuts) = arg("--cuts").and_then(|s| s.parse().ok()) {
@@ -137,7 +146,7 @@ fn main() -> chatter_gap::Result<()> {
                 eprintln!("synthesized in {:.1} s", start.elapsed().as_secs_f64());
                 let start = Instant::now();
                 let options = DiagnoseOptions {
-                    seed,
+                    seed: seed + sampler_offset,
                     ..options.clone()
                 };
                 let d = diagnose(&machine.model, &data, &options, &Log(Instant::now()))?;

@@ -20,7 +20,9 @@
 //! the boundary). A chattering cut reports the frequency of the dominant multiplier at its own
 //! depth with relative jitter. Poles are the dominant closed-loop poles of stable cuts (fractions
 //! of the true limit at the pole speeds), lifted for milling, with relative frequency and
-//! damping noise, as repeated operational modal analysis would give.
+//! damping noise, as repeated operational modal analysis would give; in turning the resonance
+//! (`chatter_stability::resonance`), since the dominant roots of slow surface regeneration under
+//! process damping at low speed respond at spindle harmonics, which the analysis removes.
 //!
 //! ```no_run
 //! use chatter_gap::{HiddenEffect, Scenario, nominal_milling, synthesize};
@@ -40,9 +42,9 @@ use chatter_dynamics::{
     Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Observations,
     Operation, PoleObservation, Turning,
 };
-use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use chatter_stability::{DominantMultiplier, StabilitySolver};
 use num_complex::Complex64;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
@@ -628,8 +630,29 @@ fn truth_at(model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<(f64, f6
         solver.chatter_frequency_hz(model, speed_rpm, depth_m)
     })
     .map_err(|e| GapError::Model(format!("truth at {speed_rpm} rpm, {depth_m} m: {e}")))?;
+    Ok(truth_root(mu, f))
+}
+
+/// The pole that an identification of a stable turning cut sees: the truth's resonance
+/// ([`Discretization::resonance_frequency_hz`]), not a dominant multiplier at the spindle
+/// harmonics (slow surface regeneration under process damping at low speed, whose response an
+/// identification removes as forced lines), as ln|mu|, frequency and lambda like [`truth_at`].
+fn truth_resonance_at(
+    model: &ModalModel,
+    speed_rpm: f64,
+    depth_m: f64,
+) -> Result<(f64, f64, Complex64)> {
+    let (mu, f) = with_truth(model, speed_rpm, |solver| {
+        solver.resonance_frequency_hz(model, speed_rpm, depth_m)
+    })
+    .map_err(|e| GapError::Model(format!("truth pole at {speed_rpm} rpm, {depth_m} m: {e}")))?;
+    Ok(truth_root(mu, f))
+}
+
+/// ln|mu|, the frequency and the continuous-time pole of a truth multiplier and its frequency.
+fn truth_root(mu: DominantMultiplier, f: f64) -> (f64, f64, Complex64) {
     let lambda = Complex64::new(mu.modulus().ln() / mu.period_s, 2.0 * PI * f);
-    Ok((mu.modulus().ln(), f, lambda))
+    (mu.modulus().ln(), f, lambda)
 }
 
 /// The run order of `scenario` on the machine `nominal`: cuts at `scenario.speeds` random
@@ -736,7 +759,11 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
                 });
             }
             PlannedKind::Pole { .. } => {
-                let (_, _, lambda) = truth_at(&model, speed_rpm, depth_m)?;
+                let (_, _, lambda) = if milling {
+                    truth_at(&model, speed_rpm, depth_m)?
+                } else {
+                    truth_resonance_at(&model, speed_rpm, depth_m)?
+                };
                 let tau = model.operation().delay_s(speed_rpm);
                 // a lifted pole: the principal value of ln(mu) / tau
                 let lambda = if milling {

@@ -14,7 +14,8 @@
 //!    (C b ydot / V, seed 003), `speed_dependent_dynamics` (f_n(Omega) = f_n0 (1 - c Omega^2)),
 //!    `extra_mode` and `drift` (cutting coefficients changing with `sequence`). The log-evidence
 //!    ln p(D | M) of each comes from iTMCMC (`chatter-bayes`), the posterior class probabilities
-//!    from equal prior odds (000 Eq. 32), and the verdict is the most probable class unless a
+//!    from equal prior odds (000 Eq. 32), and the verdict is the most probable class (an effect
+//!    needs a Bayes factor of 10 over plain recalibration, which it contains) unless a
 //!    posterior predictive check ([`PredictiveCheck`]) finds its residuals inconsistent with
 //!    the noise: then it is `unexplained` rather than a confident wrong name.
 //! 3. **How far it shrinks** ([`shrink`]): on held-out observations (k-fold, or leave one speed

@@ -43,7 +43,7 @@ use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
 use chatter_stability::frequency_domain::{
-    FrequencyDomain, dominant_and_unstable_poles, dominant_pole, mode_poles,
+    FrequencyDomain, dominant_and_unstable_poles, dominant_resonance_pole, mode_poles,
 };
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::multiplier::DominantMultiplier;
@@ -183,8 +183,10 @@ pub(crate) fn predict_cut(
 /// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).
 /// For milling it is the dominant multiplier's. For turning, where an identification of a
 /// multi-mode machine may lock onto a mode's own pole rather than the least-damped root, it is
-/// the one of {dominant root, each mode's continued pole} closest in frequency to the identified
-/// `observed_hz` (mode pairing, as in modal updating).
+/// the one of {the resonance (dominant root off the spindle harmonics), each mode's continued
+/// pole} closest in frequency to the identified `observed_hz` (mode pairing, as in modal
+/// updating); the roots of slow surface regeneration, dominant under process damping at low
+/// speed, respond at spindle harmonics, which an identification removes.
 pub(crate) fn predict_pole(
     variant: &Variant,
     speed_rpm: f64,
@@ -204,7 +206,7 @@ pub(crate) fn predict_pole(
         );
         observed_pole(lambda, true)
     } else {
-        let dominant = dominant_pole(&model, speed_rpm, depth_m).ok()?;
+        let dominant = dominant_resonance_pole(&model, speed_rpm, depth_m).ok()?;
         mode_poles(&model, speed_rpm, depth_m)
             .ok()?
             .into_iter()

@@ -17,6 +17,7 @@
 use crate::StabilitySolver;
 use crate::error::{Result, StabilityError, check_condition};
 use crate::multiplier::DominantMultiplier;
+use crate::resonance::{SUBSTRUCTURAL, near_harmonic};
 use chatter_dynamics::pole::pole_frequency_damping;
 use chatter_dynamics::{ModalModel, Operation};
 use nalgebra::DMatrix;
@@ -214,8 +215,9 @@ fn continued_poles(
 /// the structural pole in the width does not always end on the dominant root, nor always
 /// succeed (at long delays e^{-lambda tau} is large at a damped pole and Newton's basin
 /// small), so Newton is started on the imaginary axis, where stability is decided, on a grid
-/// around every mode (spacing a quarter of the spindle frequency, +-15 % of the natural
-/// frequency, at most 12 iterations each) and on the negative real axis at -x / tau
+/// around every mode (spacing a quarter of the spindle frequency, from 15 % below the lower to
+/// 15 % above the higher of the natural frequency and the frequency with the cut's mean
+/// stiffness sqrt(omega^2 + b W_ii), which deep cuts reach, at most 12 iterations each) and on the negative real axis at -x / tau
 /// (x = 0.05, 0.3, 1, 3: the real root of slow surface regeneration, which dominates with
 /// process damping at low speed), and the root with the largest real part wins; an error only
 /// when no start converges. Checked against the first-order full discretization at
@@ -224,6 +226,29 @@ fn continued_poles(
 pub fn dominant_pole(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<ClosedLoopPole> {
     grid_roots(model, speed_rpm, width_m)?
         .into_iter()
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(ClosedLoopPole::new)
+        .ok_or_else(|| no_root(speed_rpm, width_m))
+}
+
+/// The resonance of a cut: the closed-loop pole with the largest real part whose multiplier
+/// e^{lambda tau} keeps clear of the spindle harmonics and whose frequency is structural
+/// ([`crate::resonance`]), from the starts of [`dominant_pole`]. It is what an identification of a stable cut sees when the dominant
+/// roots are the real one of slow surface regeneration and its chain at spindle harmonics
+/// (process damping at low speed).
+pub fn dominant_resonance_pole(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+) -> Result<ClosedLoopPole> {
+    let tau = model.operation().delay_s(speed_rpm);
+    let lowest = model
+        .omegas_rad_s()
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    grid_roots(model, speed_rpm, width_m)?
+        .into_iter()
+        .filter(|r| !near_harmonic((r * tau).exp()) && r.im >= SUBSTRUCTURAL * lowest)
         .max_by(|a, b| a.re.total_cmp(&b.re))
         .map(ClosedLoopPole::new)
         .ok_or_else(|| no_root(speed_rpm, width_m))
@@ -276,12 +301,20 @@ fn grid_roots(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<Vec<Co
     // the real (non-oscillating) root of the slow surface regeneration, which dominates with
     // process damping at low speed: |lambda| ~ 1 / tau
     let real_starts = REAL_STARTS.iter().map(|x| Complex64::new(-x / ch.tau, 0.0));
-    Ok(ch
-        .omegas
-        .iter()
-        .flat_map(|&w| {
-            let k = (0.15 * w / spacing).ceil() as i64;
-            (-k..=k).map(move |j| Complex64::new(0.0, w + j as f64 * spacing))
+    // the cutting stiffness moves the roots of a deep cut away from the structural frequency:
+    // the grid also covers sqrt(omega^2 + b W_ii), the frequency with the cut's mean stiffness
+    let shifted = |i: usize| {
+        let w = ch.omegas[i];
+        (w * w + width_m * ch.coupling[(i, i)])
+            .max(0.01 * w * w)
+            .sqrt()
+    };
+    Ok((0..ch.omegas.len())
+        .flat_map(|i| {
+            let (w, w_cut) = (ch.omegas[i], shifted(i));
+            let below = ((w - w.min(w_cut) + 0.15 * w) / spacing).ceil() as i64;
+            let above = ((w.max(w_cut) - w + 0.15 * w) / spacing).ceil() as i64;
+            (-below..=above).map(move |j| Complex64::new(0.0, w + j as f64 * spacing))
         })
         .chain(real_starts)
         .filter_map(|start| ch.newton(start, width_m, GRID_NEWTON_ITERATIONS))

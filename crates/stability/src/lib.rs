@@ -18,6 +18,7 @@ pub mod monodromy;
 pub mod multiplier;
 pub mod prepared;
 pub mod process_damping;
+pub mod resonance;
 mod root;
 pub mod sensitivity;
 mod step;

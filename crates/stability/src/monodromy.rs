@@ -206,6 +206,33 @@ impl Discretization {
     }
 }
 
+impl Monodromy {
+    /// The multiplier `mu` with eigenvector `vector` and its chatter frequency: the member of its
+    /// frequency family that [`Self::eigenvector_frequency_hz`] picks within half the lowest to
+    /// twice the highest natural frequency, or the member nearest the dominant mode when the
+    /// eigenfunction is not sampled over the whole delay.
+    pub(crate) fn multiplier_and_frequency(
+        &self,
+        model: &ModalModel,
+        mu: Complex64,
+        vector: &[Complex64],
+    ) -> (DominantMultiplier, f64) {
+        let mu = DominantMultiplier::new(mu, self.period_s);
+        let (lo, hi) = model
+            .modes()
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
+                (lo.min(m.frequency_hz()), hi.max(m.frequency_hz()))
+            });
+        let f = self
+            .eigenvector_frequency_hz(vector, &mu, (0.5 * lo, 2.0 * hi))
+            .unwrap_or_else(|| {
+                mu.chatter_frequency_near_hz(crate::boundary::dominant_mode_frequency_hz(model))
+            });
+        (mu, f)
+    }
+}
+
 /// One step of the program: y_{k+1} = P y_k + R q_a + S q_b where q_a, q_b are the delayed
 /// values at the step's start and end grid points. The blocks live in [`Monodromy::coefficients`]
 /// from `offset`: P (2N x 2N), then for cutting steps R and S (2N x N each), row-major.
@@ -457,10 +484,8 @@ impl Monodromy {
         )
     }
 
-    /// The dominant multiplier of this operator (of `model`) with its chatter frequency (Hz):
-    /// [`Self::eigenvector_frequency_hz`] within half the lowest to twice the highest natural
-    /// frequency, else the member of the multiplier's frequency family nearest the mode that
-    /// dominates the cut. The Krylov iteration starts from `start` (see
+    /// The dominant multiplier of this operator (of `model`) with its chatter frequency (Hz), as
+    /// [`Self::multiplier_and_frequency`] picks it. The Krylov iteration starts from `start` (see
     /// [`Self::dominant_eigenpair_from`]).
     pub fn chatter_frequency_from(
         &self,
@@ -468,19 +493,7 @@ impl Monodromy {
         start: Option<&[f64]>,
     ) -> Result<(DominantMultiplier, f64)> {
         let (mu, vector) = self.dominant_eigenpair_from(start)?;
-        let mu = DominantMultiplier::new(mu, self.period_s);
-        let (lo, hi) = model
-            .modes()
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
-                (lo.min(m.frequency_hz()), hi.max(m.frequency_hz()))
-            });
-        let f = self
-            .eigenvector_frequency_hz(&vector, &mu, (0.5 * lo, 2.0 * hi))
-            .unwrap_or_else(|| {
-                mu.chatter_frequency_near_hz(crate::boundary::dominant_mode_frequency_hz(model))
-            });
-        Ok((mu, f))
+        Ok(self.multiplier_and_frequency(model, mu, &vector))
     }
 
     /// Chatter frequency (Hz) of the dominant eigenfunction: among the family f_mu + k / tau
