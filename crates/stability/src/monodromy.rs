@@ -485,7 +485,7 @@ impl Monodromy {
     }
 
     /// The dominant multiplier of this operator (of `model`) with its chatter frequency (Hz), as
-    /// [`Self::multiplier_and_frequency`] picks it. The Krylov iteration starts from `start` (see
+    /// `multiplier_and_frequency` picks it. The Krylov iteration starts from `start` (see
     /// [`Self::dominant_eigenpair_from`]).
     pub fn chatter_frequency_from(
         &self,
