@@ -11,6 +11,7 @@ pub mod boundary;
 mod eigen;
 pub mod error;
 pub mod frequency_domain;
+mod grid;
 mod hessenberg;
 mod krylov;
 pub mod monodromy;
@@ -20,6 +21,7 @@ pub mod process_damping;
 pub mod resonance;
 mod root;
 pub mod sensitivity;
+mod step;
 pub mod zero_order;
 
 pub use error::{Result, StabilityError};

@@ -33,14 +33,19 @@
 //! found by Krylov–Schur (Stewart 2002's thick-restart Arnoldi, in the crate's `krylov` module)
 //! on that operator; the dense matrix is built column by column in O(M^2 N^3) only when all
 //! eigenpairs are needed (sensitivities, cross-checks).
+//!
+//! Files: the grid in the crate's `grid` module, the step blocks and their depth-independent
+//! plan in `step` ([`StepPlan`]), the operator here, the eigen-solver in `krylov`.
 
 use crate::StabilitySolver;
 use crate::eigen::dense_eigenvalues;
 use crate::error::{Result, StabilityError, check_condition};
+use crate::grid::segments;
 pub use crate::krylov::DENSE_FALLBACK_MAX_DIM;
 use crate::krylov::{DENSE_MAX_DIM, largest, robust_eigenpair};
 use crate::multiplier::DominantMultiplier;
-use chatter_dynamics::{ModalModel, Operation};
+pub use crate::step::StepPlan;
+use chatter_dynamics::ModalModel;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -52,6 +57,16 @@ pub enum Scheme {
     Full,
     /// First-order semi-discretization (Insperger and Stépán).
     Semi,
+}
+
+impl Scheme {
+    /// Short name (`"fdm"`, `"sdm"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Scheme::Full => "fdm",
+            Scheme::Semi => "sdm",
+        }
+    }
 }
 
 /// How many steps cover the cutting part of one delay.
@@ -116,7 +131,7 @@ impl Discretization {
     }
 
     /// Cutting steps per delay for a delay that cuts during `cutting_time` seconds.
-    fn cutting_steps(&self, model: &ModalModel, cutting_time: f64) -> Result<usize> {
+    pub(crate) fn cutting_steps(&self, model: &ModalModel, cutting_time: f64) -> Result<usize> {
         match self.steps {
             StepsPerDelay::Fixed(0) => Err(StabilityError::InvalidInput {
                 field: "steps_per_delay",
@@ -140,14 +155,17 @@ impl Discretization {
     pub fn monodromy(&self, model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<Monodromy> {
         Monodromy::new(model, speed_rpm, depth_m, *self)
     }
+
+    /// The depth-independent part of the step program at `speed_rpm`, for operators at many
+    /// depths (a boundary search): [`StepPlan::monodromy`] then gives each one.
+    pub fn plan(&self, model: &ModalModel, speed_rpm: f64) -> Result<StepPlan> {
+        StepPlan::new(model, speed_rpm, *self)
+    }
 }
 
 impl StabilitySolver for Discretization {
     fn name(&self) -> &'static str {
-        match self.scheme {
-            Scheme::Full => "fdm",
-            Scheme::Semi => "sdm",
-        }
+        self.scheme.name()
     }
 
     fn dominant_multiplier(
@@ -183,9 +201,8 @@ impl Discretization {
         depth_m: f64,
         start: Option<&[f64]>,
     ) -> Result<(DominantMultiplier, f64)> {
-        let op = self.monodromy(model, speed_rpm, depth_m)?;
-        let (mu, vector) = op.dominant_eigenpair_from(start)?;
-        Ok(op.multiplier_and_frequency(model, mu, &vector))
+        self.monodromy(model, speed_rpm, depth_m)?
+            .chatter_frequency_from(model, start)
     }
 }
 
@@ -220,12 +237,12 @@ impl Monodromy {
 /// values at the step's start and end grid points. The blocks live in [`Monodromy::coefficients`]
 /// from `offset`: P (2N x 2N), then for cutting steps R and S (2N x N each), row-major.
 #[derive(Debug, Clone, Copy)]
-struct Step {
-    offset: usize,
+pub(crate) struct Step {
+    pub(crate) offset: usize,
     /// Index of the grid point at the start of the step (its delayed value is R's input); the
     /// end point is `start + 1` (or y_0 when it equals the grid size).
-    start: usize,
-    cutting: bool,
+    pub(crate) start: usize,
+    pub(crate) cutting: bool,
 }
 
 /// The discretized monodromy operator over one delay.
@@ -245,198 +262,9 @@ pub struct Monodromy {
     pub period_s: f64,
 }
 
-/// Grid of one delay: breakpoints and whether each segment cuts.
-fn segments(model: &ModalModel, speed_rpm: f64, tau: f64) -> Vec<(f64, f64, bool)> {
-    let mut cuts = vec![0.0, tau];
-    if let Operation::Milling(m) = model.operation() {
-        let omega = 2.0 * PI * speed_rpm / 60.0;
-        let (entry, exit) = m.entry_exit_rad();
-        let teeth = m.teeth();
-        for j in 0..teeth {
-            let offset = 2.0 * PI * j as f64 / teeth as f64;
-            for angle in [entry, exit] {
-                // times in [0, tau) at which tooth j reaches `angle` (mod 2 pi)
-                let t0 = (angle - offset).rem_euclid(2.0 * PI) / omega;
-                let t = t0.rem_euclid(tau);
-                if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
-                    cuts.push(t);
-                }
-            }
-        }
-    }
-    cuts.sort_by(f64::total_cmp);
-    cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
-    cuts.windows(2)
-        .map(|w| {
-            let mid = 0.5 * (w[0] + w[1]);
-            let h = model.directional_matrix(mid, speed_rpm);
-            (w[0], w[1], h.abs().max() > 0.0)
-        })
-        .collect()
-}
-
-/// Van Loan: exp of [[A, I, 0], [0, 0, I], [0, 0, 0]] h gives e^{A h}, F_1 and F_2.
-fn exp_integrals(a: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
-    let n = a.nrows();
-    let mut big = DMatrix::zeros(3 * n, 3 * n);
-    big.view_mut((0, 0), (n, n)).copy_from(&(a * h));
-    for i in 0..n {
-        big[(i, n + i)] = h;
-        big[(n + i, 2 * n + i)] = h;
-    }
-    let e = big.exp();
-    let phi0 = e.view((0, 0), (n, n)).into_owned();
-    let f1 = e.view((0, n), (n, n)).into_owned();
-    // top-right block = int_0^h e^{A(h-s)} s ds / h ... scaled: block (0,2n) of exp(M h) with the
-    // unit blocks scaled by h equals int_0^h e^{A(h-s)} s ds.
-    let f2 = e.view((0, 2 * n), (n, n)).into_owned();
-    (phi0, f1, f2)
-}
-
-/// Row-major copy of a matrix.
-fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
-    m.transpose().as_slice().to_vec()
-}
-
-/// The periodic coefficients at one time in modal coordinates: M = [b W | b P] (N x 2N,
-/// row-major), so that A(t) = [[0, 0], [-M]] and B(t) = [[0], [b W]].
-struct Periodic<'a> {
-    model: &'a ModalModel,
-    speed_rpm: f64,
-    depth_m: f64,
-    /// Phi (2 x N), row-major.
-    phi: Vec<f64>,
-    modes: usize,
-}
-
-impl Periodic<'_> {
-    fn at(&self, t: f64, m: &mut [f64]) {
-        let n = self.modes;
-        let h = self.model.directional_matrix(t, self.speed_rpm);
-        let d = self.model.process_damping_matrix(t, self.speed_rpm);
-        for p in 0..n {
-            for q in 0..n {
-                let (mut w, mut pd) = (0.0, 0.0);
-                for a in 0..2 {
-                    for c in 0..2 {
-                        let f = self.phi[a * n + p] * self.phi[c * n + q];
-                        w += f * h[(a, c)];
-                        pd += f * d[(a, c)];
-                    }
-                }
-                m[p * 2 * n + q] = self.depth_m * w;
-                m[p * 2 * n + n + q] = self.depth_m * pd;
-            }
-        }
-    }
-}
-
-/// Gaussian elimination with partial pivoting of the small system `a` x = `b` in place
-/// (`a` d x d, `b` d x k, row-major); `false` when `a` is singular.
-fn solve_small(a: &mut [f64], b: &mut [f64], d: usize, k: usize) -> bool {
-    for col in 0..d {
-        let pivot = (col..d)
-            .max_by(|&i, &j| a[i * d + col].abs().total_cmp(&a[j * d + col].abs()))
-            .unwrap_or(col);
-        if a[pivot * d + col] == 0.0 || !a[pivot * d + col].is_finite() {
-            return false;
-        }
-        if pivot != col {
-            for j in 0..d {
-                a.swap(col * d + j, pivot * d + j);
-            }
-            for j in 0..k {
-                b.swap(col * k + j, pivot * k + j);
-            }
-        }
-        let inv = 1.0 / a[col * d + col];
-        for i in col + 1..d {
-            let f = a[i * d + col] * inv;
-            if f == 0.0 {
-                continue;
-            }
-            for j in col..d {
-                a[i * d + j] -= f * a[col * d + j];
-            }
-            for j in 0..k {
-                b[i * k + j] -= f * b[col * k + j];
-            }
-        }
-    }
-    for col in (0..d).rev() {
-        let inv = 1.0 / a[col * d + col];
-        for j in 0..k {
-            let mut v = b[col * k + j];
-            for i in col + 1..d {
-                v -= a[col * d + i] * b[i * k + j];
-            }
-            b[col * k + j] = v * inv;
-        }
-    }
-    true
-}
-
-/// First-order full-discretization step (Ding et al. 2010) from the periodic coefficients at the
-/// step's start (`mi`) and end (`mj`): solves (I - F_2/h A_j) [P | R | S] =
-/// [e^{A_0 h} + C_1 A_i | C_1 B_i | F_2/h B_j] with C_1 = F_1 - F_2/h, appending P, R, S to
-/// `out`. `scratch` holds the (2N)^2 system and the 2N x 4N right-hand side.
-#[allow(clippy::too_many_arguments)]
-fn full_step(
-    n: usize,
-    phi0: &[f64],
-    c1: &[f64],
-    f2h: &[f64],
-    mi: &[f64],
-    mj: &[f64],
-    scratch: &mut (Vec<f64>, Vec<f64>),
-    out: &mut Vec<f64>,
-) -> bool {
-    let d = 2 * n;
-    let k = 4 * n;
-    let (lhs, rhs) = scratch;
-    lhs.clear();
-    lhs.resize(d * d, 0.0);
-    rhs.clear();
-    rhs.resize(d * k, 0.0);
-    for r in 0..d {
-        lhs[r * d + r] = 1.0;
-        for c in 0..d {
-            // only the lower block rows of A and B are non-zero: A = [[0], [-M]], B = [[0], [W]]
-            let (mut f2a, mut c1a) = (0.0, 0.0);
-            for q in 0..n {
-                f2a += f2h[r * d + n + q] * mj[q * d + c];
-                c1a += c1[r * d + n + q] * mi[q * d + c];
-            }
-            lhs[r * d + c] += f2a;
-            rhs[r * k + c] = phi0[r * d + c] - c1a;
-        }
-        for c in 0..n {
-            let (mut c1b, mut f2b) = (0.0, 0.0);
-            for q in 0..n {
-                c1b += c1[r * d + n + q] * mi[q * d + c];
-                f2b += f2h[r * d + n + q] * mj[q * d + c];
-            }
-            rhs[r * k + d + c] = c1b;
-            rhs[r * k + d + n + c] = f2b;
-        }
-    }
-    if !solve_small(lhs, rhs, d, k) {
-        return false;
-    }
-    // [P | R | S] row-major blocks
-    for r in 0..d {
-        out.extend_from_slice(&rhs[r * k..r * k + d]);
-    }
-    for block in [d, d + n] {
-        for r in 0..d {
-            out.extend_from_slice(&rhs[r * k + block..r * k + block + n]);
-        }
-    }
-    true
-}
-
 impl Monodromy {
-    /// Build the step program at `speed_rpm`, depth `depth_m`.
+    /// Build the step program at `speed_rpm`, depth `depth_m` (the [`StepPlan`] of the speed,
+    /// used once).
     pub fn new(
         model: &ModalModel,
         speed_rpm: f64,
@@ -444,135 +272,26 @@ impl Monodromy {
         method: Discretization,
     ) -> Result<Self> {
         check_condition(speed_rpm, depth_m)?;
-        let n = model.mode_count();
-        let d = 2 * n;
-        let tau = model.operation().delay_s(speed_rpm);
-        let segs = segments(model, speed_rpm, tau);
-        let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
-        let m_cut = method.cutting_steps(model, cutting_time)?;
-        // structural matrices
-        let omegas = model.omegas_rad_s();
-        let zetas = model.damping_ratios();
-        let mut a0 = DMatrix::zeros(d, d);
-        for i in 0..n {
-            a0[(i, n + i)] = 1.0;
-            a0[(n + i, i)] = -omegas[i] * omegas[i];
-            a0[(n + i, n + i)] = -2.0 * zetas[i] * omegas[i];
-        }
-        let periodic = Periodic {
-            model,
-            speed_rpm,
-            depth_m,
-            phi: row_major(&model.shape_matrix()),
-            modes: n,
-        };
-        // constant coefficients (turning): every step of a segment is the same
-        let constant = matches!(model.operation(), Operation::Turning(_));
-        let mut steps = Vec::with_capacity(m_cut + segs.len());
-        let mut step_s = Vec::with_capacity(m_cut + segs.len());
-        let mut coefficients = Vec::new();
-        let mut scratch = (Vec::new(), Vec::new());
-        let (mut mi, mut mj) = (vec![0.0; n * d], vec![0.0; n * d]);
-        let mut grid = 0usize;
-        for &(start, end, cutting) in &segs {
-            let len = end - start;
-            if !cutting {
-                steps.push(Step {
-                    offset: coefficients.len(),
-                    start: grid,
-                    cutting: false,
-                });
-                coefficients.extend(row_major(&(&a0 * len).exp()));
-                step_s.push(len);
-                grid += 1;
-                continue;
-            }
-            let k = ((m_cut as f64 * len / cutting_time).round() as usize).max(1);
-            let h = len / k as f64;
-            let full = match method.scheme {
-                Scheme::Full => {
-                    let (phi0, f1, f2) = exp_integrals(&a0, h);
-                    let f2h = &f2 / h;
-                    Some((row_major(&phi0), row_major(&(f1 - &f2h)), row_major(&f2h)))
-                }
-                Scheme::Semi => None,
-            };
-            for i in 0..k {
-                let t0 = start + i as f64 * h;
-                if constant && i > 0 {
-                    let mut step = steps[steps.len() - 1];
-                    step.start = grid;
-                    steps.push(step);
-                    step_s.push(h);
-                    grid += 1;
-                    continue;
-                }
-                let offset = coefficients.len();
-                match &full {
-                    Some((phi0, c1, f2h)) => {
-                        // products interpolated just inside the segment (H is smooth there); the
-                        // end of step i is the start of step i + 1 (same smooth segment)
-                        let eps = 1e-9 * h;
-                        if i == 0 {
-                            periodic.at(t0 + eps, &mut mi);
-                        } else {
-                            std::mem::swap(&mut mi, &mut mj);
-                        }
-                        periodic.at(t0 + h - eps, &mut mj);
-                        if !full_step(n, phi0, c1, f2h, &mi, &mj, &mut scratch, &mut coefficients) {
-                            return Err(StabilityError::NoConvergence {
-                                solver: "full discretization",
-                                detail: format!("singular step matrix at t = {t0} s"),
-                            });
-                        }
-                    }
-                    None => {
-                        // mean of the periodic part over the step (3-point Gauss)
-                        let g = [
-                            (0.5 - 0.5 * (0.6f64).sqrt(), 5.0 / 18.0),
-                            (0.5, 8.0 / 18.0),
-                            (0.5 + 0.5 * (0.6f64).sqrt(), 5.0 / 18.0),
-                        ];
-                        let mut mean = vec![0.0; n * d];
-                        for (x, wgt) in g {
-                            periodic.at(t0 + x * h, &mut mi);
-                            for (a, b) in mean.iter_mut().zip(&mi) {
-                                *a += wgt * b;
-                            }
-                        }
-                        let mut a = a0.clone();
-                        let mut bm = DMatrix::zeros(d, n);
-                        for p in 0..n {
-                            for c in 0..d {
-                                a[(n + p, c)] -= mean[p * d + c];
-                            }
-                            for c in 0..n {
-                                bm[(n + p, c)] = mean[p * d + c];
-                            }
-                        }
-                        let (e, f1, f2) = exp_integrals(&a, h);
-                        coefficients.extend(row_major(&e));
-                        coefficients.extend(row_major(&((&f1 - &f2 / h) * &bm)));
-                        coefficients.extend(row_major(&(&f2 / h * &bm)));
-                    }
-                }
-                steps.push(Step {
-                    offset,
-                    start: grid,
-                    cutting: true,
-                });
-                step_s.push(h);
-                grid += 1;
-            }
-        }
-        Ok(Self {
-            modes: n,
+        StepPlan::new(model, speed_rpm, method)?.monodromy(depth_m)
+    }
+
+    /// The operator of a step program (see [`StepPlan::monodromy`]).
+    pub(crate) fn from_steps(
+        modes: usize,
+        grid: usize,
+        steps: Vec<Step>,
+        coefficients: Vec<f64>,
+        step_s: Vec<f64>,
+        period_s: f64,
+    ) -> Self {
+        Self {
+            modes,
             grid,
             steps,
             coefficients,
             step_s,
-            period_s: tau,
-        })
+            period_s,
+        }
     }
 
     /// Dimension of the state [y_0; delayed q at M grid points] = 2N + N M.
@@ -765,6 +484,18 @@ impl Monodromy {
         )
     }
 
+    /// The dominant multiplier of this operator (of `model`) with its chatter frequency (Hz), as
+    /// `multiplier_and_frequency` picks it. The Krylov iteration starts from `start` (see
+    /// [`Self::dominant_eigenpair_from`]).
+    pub fn chatter_frequency_from(
+        &self,
+        model: &ModalModel,
+        start: Option<&[f64]>,
+    ) -> Result<(DominantMultiplier, f64)> {
+        let (mu, vector) = self.dominant_eigenpair_from(start)?;
+        Ok(self.multiplier_and_frequency(model, mu, &vector))
+    }
+
     /// Chatter frequency (Hz) of the dominant eigenfunction: among the family f_mu + k / tau
     /// (within half the lowest to twice the highest natural frequency) the member with the largest
     /// Fourier amplitude of the delayed displacements over one delay. `None` when the grid has
@@ -783,32 +514,30 @@ impl Monodromy {
         let ft = 1.0 / self.period_s;
         let k_max = (band_hz.1 / ft).ceil() as i32 + 1;
         let candidates = multiplier.frequency_family_hz(0..=k_max);
-        let mut times = Vec::with_capacity(self.grid);
-        let mut t = 0.0;
-        for &h in &self.step_s {
-            times.push(t);
-            t += h;
-        }
         candidates
             .into_iter()
             .filter(|f| *f >= band_hz.0 && *f <= band_hz.1)
             .map(|f| {
-                // |V(f)|^2 + |V(-f)|^2: the same for the eigenvector of either member of a
-                // complex-conjugate pair of multipliers
-                let amplitude: f64 = (0..n)
-                    .flat_map(|j| [(j, f), (j, -f)])
-                    .map(|(j, f)| {
-                        let sum: Complex64 = (0..self.grid)
-                            .map(|k| {
-                                let phase = -2.0 * PI * f * times[k];
-                                vector[s2 + k * n + j]
-                                    * Complex64::new(phase.cos(), phase.sin())
-                                    * self.step_s[k]
-                            })
-                            .sum();
-                        sum.norm_sqr()
-                    })
-                    .sum();
+                // V_j(f) = sum_k v_jk e^{-2 pi i f t_k} h_k, the phasor advanced step by step
+                // (a new rotation only where the step length changes); |V(f)|^2 + |V(-f)|^2 is
+                // the same for the eigenvector of either member of a conjugate pair
+                let mut plus = vec![Complex64::new(0.0, 0.0); n];
+                let mut minus = vec![Complex64::new(0.0, 0.0); n];
+                let mut phasor = Complex64::new(1.0, 0.0);
+                let mut rotation = (f64::NAN, phasor);
+                for (k, &h) in self.step_s.iter().enumerate() {
+                    let weight = phasor * h;
+                    for (j, (p, m)) in plus.iter_mut().zip(minus.iter_mut()).enumerate() {
+                        let v = vector[s2 + k * n + j];
+                        *p += v * weight;
+                        *m += v * weight.conj();
+                    }
+                    if h != rotation.0 {
+                        rotation = (h, Complex64::from_polar(1.0, -2.0 * PI * f * h));
+                    }
+                    phasor *= rotation.1;
+                }
+                let amplitude: f64 = plus.iter().chain(&minus).map(|z| z.norm_sqr()).sum();
                 (f, amplitude)
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))

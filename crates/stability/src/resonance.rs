@@ -119,7 +119,7 @@ fn failed(detail: String) -> StabilityError {
 impl Monodromy {
     /// The eigenvalue of largest modulus that `accept` takes, with its eigenvector, by deflation
     /// of the larger ones (module docs). An error when the solver fails, or when more than
-    /// [`MAX_DEFLATED`] rejected multipliers lie above it.
+    /// 40 (`MAX_DEFLATED`) rejected multipliers lie above it.
     pub fn dominant_eigenpair_where(
         &self,
         accept: impl Fn(Complex<f64>, &[Complex<f64>]) -> bool,

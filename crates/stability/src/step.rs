@@ -1,0 +1,459 @@
+//! The steps of the discretizations (see [`crate::monodromy`] for the equations; the grid is in
+//! the crate's `grid` module):
+//! the depth-independent part of a step program at one speed, prepared once ([`StepPlan`]) and
+//! turned into the monodromy operator at any depth ([`StepPlan::monodromy`]).
+//!
+//! At one speed and grid only the depth changes along a boundary search, and the periodic
+//! coefficients scale with it (A(t) = [[0, 0], [-b W(t), -b P(t)]], B(t) = [[0], [b W(t)]]). The
+//! plan therefore holds everything else: the grid aligned with tooth entry and exit, the free-flight
+//! exponentials e^{A_0 L}, the full discretization's e^{A_0 h}, F_1 and F_2 of each cutting
+//! segment, and the modal W(t) and P(t) at the times the steps sample them (per unit depth). A
+//! monodromy at depth b then costs the step solves alone; it is the same operator, to the last
+//! bit, as one built from scratch.
+
+use crate::error::{Result, StabilityError, check_condition};
+use crate::grid::segments;
+use crate::monodromy::{Discretization, Monodromy, Scheme, Step};
+use chatter_dynamics::{ModalModel, Operation};
+use nalgebra::DMatrix;
+
+/// Van Loan: exp of [[A, I, 0], [0, 0, I], [0, 0, 0]] h gives e^{A h}, F_1 and F_2.
+fn exp_integrals(a: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let n = a.nrows();
+    let mut big = DMatrix::zeros(3 * n, 3 * n);
+    big.view_mut((0, 0), (n, n)).copy_from(&(a * h));
+    for i in 0..n {
+        big[(i, n + i)] = h;
+        big[(n + i, 2 * n + i)] = h;
+    }
+    let e = big.exp();
+    let phi0 = e.view((0, 0), (n, n)).into_owned();
+    let f1 = e.view((0, n), (n, n)).into_owned();
+    // top-right block = int_0^h e^{A(h-s)} s ds / h ... scaled: block (0,2n) of exp(M h) with the
+    // unit blocks scaled by h equals int_0^h e^{A(h-s)} s ds.
+    let f2 = e.view((0, 2 * n), (n, n)).into_owned();
+    (phi0, f1, f2)
+}
+
+/// Row-major copy of a matrix.
+pub(crate) fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+    m.transpose().as_slice().to_vec()
+}
+
+/// The periodic coefficients per unit depth at one time in modal coordinates: [W | P]
+/// (N x 2N, row-major), W = Phi^T H(t) Phi and P = Phi^T D(t) Phi.
+struct Periodic<'a> {
+    model: &'a ModalModel,
+    speed_rpm: f64,
+    /// Phi (2 x N), row-major.
+    phi: Vec<f64>,
+    modes: usize,
+}
+
+impl Periodic<'_> {
+    /// Append [W | P] at time `t` to `out`.
+    fn push(&self, t: f64, out: &mut Vec<f64>) {
+        let n = self.modes;
+        let h = self.model.directional_matrix(t, self.speed_rpm);
+        let d = self.model.process_damping_matrix(t, self.speed_rpm);
+        let at = out.len();
+        out.resize(at + 2 * n * n, 0.0);
+        let m = &mut out[at..];
+        for p in 0..n {
+            for q in 0..n {
+                let (mut w, mut pd) = (0.0, 0.0);
+                for a in 0..2 {
+                    for c in 0..2 {
+                        let f = self.phi[a * n + p] * self.phi[c * n + q];
+                        w += f * h[(a, c)];
+                        pd += f * d[(a, c)];
+                    }
+                }
+                m[p * 2 * n + q] = w;
+                m[p * 2 * n + n + q] = pd;
+            }
+        }
+    }
+}
+
+/// `out` = b `unit`: the periodic coefficients M = [b W | b P] at depth b, so that
+/// A(t) = [[0, 0], [-M]] and B(t) = [[0], [b W]].
+fn scaled(depth_m: f64, unit: &[f64], out: &mut [f64]) {
+    for (o, u) in out.iter_mut().zip(unit) {
+        *o = depth_m * u;
+    }
+}
+
+/// Gaussian elimination with partial pivoting of the small system `a` x = `b` in place
+/// (`a` d x d, `b` d x k, row-major); `false` when `a` is singular.
+fn solve_small(a: &mut [f64], b: &mut [f64], d: usize, k: usize) -> bool {
+    for col in 0..d {
+        let pivot = (col..d)
+            .max_by(|&i, &j| a[i * d + col].abs().total_cmp(&a[j * d + col].abs()))
+            .unwrap_or(col);
+        if a[pivot * d + col] == 0.0 || !a[pivot * d + col].is_finite() {
+            return false;
+        }
+        if pivot != col {
+            for j in 0..d {
+                a.swap(col * d + j, pivot * d + j);
+            }
+            for j in 0..k {
+                b.swap(col * k + j, pivot * k + j);
+            }
+        }
+        let inv = 1.0 / a[col * d + col];
+        for i in col + 1..d {
+            let f = a[i * d + col] * inv;
+            if f == 0.0 {
+                continue;
+            }
+            for j in col..d {
+                a[i * d + j] -= f * a[col * d + j];
+            }
+            for j in 0..k {
+                b[i * k + j] -= f * b[col * k + j];
+            }
+        }
+    }
+    for col in (0..d).rev() {
+        let inv = 1.0 / a[col * d + col];
+        for j in 0..k {
+            let mut v = b[col * k + j];
+            for i in col + 1..d {
+                v -= a[col * d + i] * b[i * k + j];
+            }
+            b[col * k + j] = v * inv;
+        }
+    }
+    true
+}
+
+/// The constant matrices of the full discretization on one cutting segment of step h:
+/// e^{A_0 h}, C_1 = F_1 - F_2/h and F_2/h, row-major.
+#[derive(Debug, Clone)]
+struct FullSegment {
+    phi0: Vec<f64>,
+    c1: Vec<f64>,
+    f2h: Vec<f64>,
+}
+
+impl FullSegment {
+    fn new(a0: &DMatrix<f64>, h: f64) -> Self {
+        let (phi0, f1, f2) = exp_integrals(a0, h);
+        let f2h = &f2 / h;
+        Self {
+            phi0: row_major(&phi0),
+            c1: row_major(&(f1 - &f2h)),
+            f2h: row_major(&f2h),
+        }
+    }
+
+    /// First-order full-discretization step (Ding et al. 2010) from the periodic coefficients at
+    /// the step's start (`mi`) and end (`mj`): solves (I - F_2/h A_j) [P | R | S] =
+    /// [e^{A_0 h} + C_1 A_i | C_1 B_i | F_2/h B_j], appending P, R, S to `out`. `scratch` holds
+    /// the (2N)^2 system and the 2N x 4N right-hand side.
+    fn step(
+        &self,
+        n: usize,
+        mi: &[f64],
+        mj: &[f64],
+        scratch: &mut (Vec<f64>, Vec<f64>),
+        out: &mut Vec<f64>,
+    ) -> bool {
+        let (phi0, c1, f2h) = (&self.phi0, &self.c1, &self.f2h);
+        let d = 2 * n;
+        let k = 4 * n;
+        let (lhs, rhs) = scratch;
+        lhs.clear();
+        lhs.resize(d * d, 0.0);
+        rhs.clear();
+        rhs.resize(d * k, 0.0);
+        for r in 0..d {
+            lhs[r * d + r] = 1.0;
+            for c in 0..d {
+                // only the lower block rows of A and B are non-zero: A = [[0], [-M]], B = [[0], [W]]
+                let (mut f2a, mut c1a) = (0.0, 0.0);
+                for q in 0..n {
+                    f2a += f2h[r * d + n + q] * mj[q * d + c];
+                    c1a += c1[r * d + n + q] * mi[q * d + c];
+                }
+                lhs[r * d + c] += f2a;
+                rhs[r * k + c] = phi0[r * d + c] - c1a;
+            }
+            for c in 0..n {
+                let (mut c1b, mut f2b) = (0.0, 0.0);
+                for q in 0..n {
+                    c1b += c1[r * d + n + q] * mi[q * d + c];
+                    f2b += f2h[r * d + n + q] * mj[q * d + c];
+                }
+                rhs[r * k + d + c] = c1b;
+                rhs[r * k + d + n + c] = f2b;
+            }
+        }
+        if !solve_small(lhs, rhs, d, k) {
+            return false;
+        }
+        // [P | R | S] row-major blocks
+        for r in 0..d {
+            out.extend_from_slice(&rhs[r * k..r * k + d]);
+        }
+        for block in [d, d + n] {
+            for r in 0..d {
+                out.extend_from_slice(&rhs[r * k + block..r * k + block + n]);
+            }
+        }
+        true
+    }
+}
+
+/// Gauss-Legendre points (fractions of the step) and weights of the semi-discretization's step
+/// mean of the periodic coefficients.
+fn gauss_points() -> [(f64, f64); 3] {
+    [
+        (0.5 - 0.5 * (0.6f64).sqrt(), 5.0 / 18.0),
+        (0.5, 8.0 / 18.0),
+        (0.5 + 0.5 * (0.6f64).sqrt(), 5.0 / 18.0),
+    ]
+}
+
+/// One segment of the grid, with what its steps need at any depth.
+#[derive(Debug, Clone)]
+enum Segment {
+    /// No tooth cuts: one exact step e^{A_0 L} (row-major) of length L.
+    Free { exp: Vec<f64>, length_s: f64 },
+    /// `steps` cutting steps of length `h` from `start_s`; `unit` holds [W | P] per unit depth
+    /// where the steps sample them: full discretization just inside the segment's start, then
+    /// just inside each step's end; semi-discretization at the three Gauss points of each step.
+    /// With constant coefficients (turning) only the first step is sampled.
+    Cutting {
+        start_s: f64,
+        steps: usize,
+        h: f64,
+        full: Option<FullSegment>,
+        unit: Vec<f64>,
+    },
+}
+
+/// The depth-independent part of the step program of one discretization at one speed: the grid,
+/// the constant exponentials and the periodic coefficients per unit depth (see the module docs).
+#[derive(Debug, Clone)]
+pub struct StepPlan {
+    modes: usize,
+    scheme: Scheme,
+    a0: DMatrix<f64>,
+    segments: Vec<Segment>,
+    /// Whether the coefficients are constant (turning): every step of a segment is the same.
+    constant: bool,
+    period_s: f64,
+}
+
+impl StepPlan {
+    /// The plan of `method` for `model` at `speed_rpm`.
+    pub fn new(model: &ModalModel, speed_rpm: f64, method: Discretization) -> Result<Self> {
+        check_condition(speed_rpm, 0.0)?;
+        let n = model.mode_count();
+        let d = 2 * n;
+        let tau = model.operation().delay_s(speed_rpm);
+        let segs = segments(model, speed_rpm, tau);
+        let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
+        let m_cut = method.cutting_steps(model, cutting_time)?;
+        let omegas = model.omegas_rad_s();
+        let zetas = model.damping_ratios();
+        let mut a0 = DMatrix::zeros(d, d);
+        for i in 0..n {
+            a0[(i, n + i)] = 1.0;
+            a0[(n + i, i)] = -omegas[i] * omegas[i];
+            a0[(n + i, n + i)] = -2.0 * zetas[i] * omegas[i];
+        }
+        let periodic = Periodic {
+            model,
+            speed_rpm,
+            phi: row_major(&model.shape_matrix()),
+            modes: n,
+        };
+        let constant = matches!(model.operation(), Operation::Turning(_));
+        let segments = segs
+            .iter()
+            .map(|&(start, end, cutting)| {
+                let len = end - start;
+                if !cutting {
+                    return Segment::Free {
+                        exp: row_major(&(&a0 * len).exp()),
+                        length_s: len,
+                    };
+                }
+                let k = ((m_cut as f64 * len / cutting_time).round() as usize).max(1);
+                let h = len / k as f64;
+                let sampled = if constant { 1 } else { k };
+                let mut unit = Vec::new();
+                let full = match method.scheme {
+                    Scheme::Full => {
+                        // sampled just inside the segment (H is smooth there); the end of step i
+                        // is the start of step i + 1 (same smooth segment)
+                        let eps = 1e-9 * h;
+                        periodic.push(start + eps, &mut unit);
+                        for i in 0..sampled {
+                            periodic.push(start + i as f64 * h + h - eps, &mut unit);
+                        }
+                        Some(FullSegment::new(&a0, h))
+                    }
+                    Scheme::Semi => {
+                        for i in 0..sampled {
+                            for (x, _) in gauss_points() {
+                                periodic.push(start + i as f64 * h + x * h, &mut unit);
+                            }
+                        }
+                        None
+                    }
+                };
+                Segment::Cutting {
+                    start_s: start,
+                    steps: k,
+                    h,
+                    full,
+                    unit,
+                }
+            })
+            .collect();
+        Ok(Self {
+            modes: n,
+            scheme: method.scheme,
+            a0,
+            segments,
+            constant,
+            period_s: tau,
+        })
+    }
+
+    /// The scheme of the plan.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The monodromy operator at depth `depth_m` (m).
+    pub fn monodromy(&self, depth_m: f64) -> Result<Monodromy> {
+        check_condition(1.0, depth_m)?;
+        let n = self.modes;
+        let d = 2 * n;
+        let size = n * d;
+        let mut steps = Vec::new();
+        let mut step_s = Vec::new();
+        let mut coefficients = Vec::new();
+        let mut scratch = (Vec::new(), Vec::new());
+        let (mut mi, mut mj) = (vec![0.0; size], vec![0.0; size]);
+        let mut grid = 0usize;
+        for segment in &self.segments {
+            let (start_s, k, h, full, unit) = match segment {
+                Segment::Free { exp, length_s } => {
+                    steps.push(Step {
+                        offset: coefficients.len(),
+                        start: grid,
+                        cutting: false,
+                    });
+                    coefficients.extend_from_slice(exp);
+                    step_s.push(*length_s);
+                    grid += 1;
+                    continue;
+                }
+                Segment::Cutting {
+                    start_s,
+                    steps,
+                    h,
+                    full,
+                    unit,
+                } => (*start_s, *steps, *h, full, unit),
+            };
+            for i in 0..k {
+                if self.constant && i > 0 {
+                    let mut step = steps[steps.len() - 1];
+                    step.start = grid;
+                    steps.push(step);
+                    step_s.push(h);
+                    grid += 1;
+                    continue;
+                }
+                let offset = coefficients.len();
+                match full {
+                    Some(full) => {
+                        if i == 0 {
+                            scaled(depth_m, &unit[..size], &mut mi);
+                        } else {
+                            std::mem::swap(&mut mi, &mut mj);
+                        }
+                        scaled(depth_m, &unit[(i + 1) * size..(i + 2) * size], &mut mj);
+                        if !full.step(n, &mi, &mj, &mut scratch, &mut coefficients) {
+                            return Err(StabilityError::NoConvergence {
+                                solver: "full discretization",
+                                detail: format!(
+                                    "singular step matrix at t = {} s",
+                                    start_s + i as f64 * h
+                                ),
+                            });
+                        }
+                    }
+                    None => self.semi_step(
+                        depth_m,
+                        &unit[3 * i * size..3 * (i + 1) * size],
+                        h,
+                        &mut mi,
+                        &mut coefficients,
+                    ),
+                }
+                steps.push(Step {
+                    offset,
+                    start: grid,
+                    cutting: true,
+                });
+                step_s.push(h);
+                grid += 1;
+            }
+        }
+        Ok(Monodromy::from_steps(
+            n,
+            grid,
+            steps,
+            coefficients,
+            step_s,
+            self.period_s,
+        ))
+    }
+
+    /// Semi-discretization step (Insperger and Stépán): A_0 + A frozen at the step's mean of
+    /// the periodic part (3-point Gauss over `unit`, the three samples per unit depth) and
+    /// integrated exactly; appends P = e^{A_i h}, R = C_1 B_i and S = F_2/h B_i with the F_1, F_2
+    /// of A_i. `buffer` holds one scaled sample.
+    fn semi_step(
+        &self,
+        depth_m: f64,
+        unit: &[f64],
+        h: f64,
+        buffer: &mut [f64],
+        out: &mut Vec<f64>,
+    ) {
+        let n = self.modes;
+        let d = 2 * n;
+        let size = n * d;
+        let mut mean = vec![0.0; size];
+        for (j, (_, wgt)) in gauss_points().into_iter().enumerate() {
+            scaled(depth_m, &unit[j * size..(j + 1) * size], buffer);
+            for (a, b) in mean.iter_mut().zip(buffer.iter()) {
+                *a += wgt * b;
+            }
+        }
+        let mut a = self.a0.clone();
+        let mut bm = DMatrix::zeros(d, n);
+        for p in 0..n {
+            for c in 0..d {
+                a[(n + p, c)] -= mean[p * d + c];
+            }
+            for c in 0..n {
+                bm[(n + p, c)] = mean[p * d + c];
+            }
+        }
+        let (e, f1, f2) = exp_integrals(&a, h);
+        out.extend(row_major(&e));
+        out.extend(row_major(&((&f1 - &f2 / h) * &bm)));
+        out.extend(row_major(&(&f2 / h * &bm)));
+    }
+}
