@@ -53,7 +53,7 @@ pub struct DiagnoseOptions {
     /// verdict is `consistent` whatever the Bayes factor.
     pub equivalence_std: f64,
     /// Rounds of further Metropolis-Hastings moves of the named class's posterior samples before
-    /// its predictive check ([`polish`]); 0 turns them off.
+    /// its predictive check (`rejuvenate` of chatter-bayes; the evidence stays the sampler's); 0 turns them off.
     pub polish_rounds: usize,
     /// Held-out validation of the gap's shrinkage.
     pub validation: Validation,
