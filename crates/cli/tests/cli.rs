@@ -996,12 +996,9 @@ fn zoa_lobes_include_process_damping() {
 /// line wins); a bad value is a clear error. Skipped with a message when the data are absent.
 #[test]
 fn oma_refuses_the_real_chatter_record() {
-    let record = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/real/milling_chatter_record/test255_accelY.csv");
-    if !record.exists() {
-        eprintln!("skipped: {} is absent", record.display());
+    let Some(record) = real_data("milling_chatter_record/test255_accelY.csv") else {
         return;
-    }
+    };
     let dir = tempfile::tempdir().unwrap();
     let obs = dir.path().join("obs.json");
     std::fs::write(
@@ -1062,12 +1059,9 @@ fn oma_refuses_the_real_chatter_record() {
 /// absent.
 #[test]
 fn detect_estimates_the_speed_of_a_sound_clip() {
-    let clip = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/real/milling_chatter_record/metalcutting_nochatter8058.mp3");
-    if !clip.exists() {
-        eprintln!("skipped: {} is absent", clip.display());
+    let Some(clip) = real_data("milling_chatter_record/metalcutting_nochatter8058.mp3") else {
         return;
-    }
+    };
     let dir = tempfile::tempdir().unwrap();
     let obs = dir.path().join("obs.json");
     std::fs::write(
