@@ -42,9 +42,9 @@ use chatter_dynamics::{
     Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Observations,
     Operation, PoleObservation, Turning,
 };
+use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::{Discretization, StepsPerDelay};
-use chatter_stability::{DominantMultiplier, StabilitySolver};
 use num_complex::Complex64;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
@@ -623,36 +623,37 @@ pub struct PlannedTest {
     pub sequence: Option<i64>,
 }
 
-/// ln|mu| and the frequency of the dominant multiplier of the truth at a cut, with the
-/// continuous-time pole lambda it implies (physical frequency).
-fn truth_at(model: &ModalModel, speed_rpm: f64, depth_m: f64) -> Result<(f64, f64, Complex64)> {
-    let (mu, f) = with_truth(model, speed_rpm, |solver| {
-        solver.chatter_frequency_hz(model, speed_rpm, depth_m)
-    })
-    .map_err(|e| GapError::Model(format!("truth at {speed_rpm} rpm, {depth_m} m: {e}")))?;
-    Ok(truth_root(mu, f))
+/// Which multiplier of the truth an observation reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TruthRoot {
+    /// The dominant one: cut labels and chatter frequencies, milling poles.
+    Dominant,
+    /// The resonance ([`Discretization::resonance_frequency_hz`]): what an identification of a
+    /// stable turning cut sees, not a dominant multiplier at the spindle harmonics (slow surface
+    /// regeneration under process damping at low speed, whose response an identification
+    /// removes as forced lines).
+    Resonance,
 }
 
-/// The pole that an identification of a stable turning cut sees: the truth's resonance
-/// ([`Discretization::resonance_frequency_hz`]), not a dominant multiplier at the spindle
-/// harmonics (slow surface regeneration under process damping at low speed, whose response an
-/// identification removes as forced lines), as ln|mu|, frequency and lambda like [`truth_at`].
-fn truth_resonance_at(
+/// ln|mu| and the frequency of the truth's `root` multiplier at a cut, with the continuous-time
+/// pole lambda it implies (physical frequency).
+fn truth_at(
     model: &ModalModel,
     speed_rpm: f64,
     depth_m: f64,
+    root: TruthRoot,
 ) -> Result<(f64, f64, Complex64)> {
-    let (mu, f) = with_truth(model, speed_rpm, |solver| {
-        solver.resonance_frequency_hz(model, speed_rpm, depth_m)
+    let (mu, f) = with_truth(model, speed_rpm, |solver| match root {
+        TruthRoot::Dominant => solver.chatter_frequency_hz(model, speed_rpm, depth_m),
+        TruthRoot::Resonance => solver.resonance_frequency_hz(model, speed_rpm, depth_m),
     })
-    .map_err(|e| GapError::Model(format!("truth pole at {speed_rpm} rpm, {depth_m} m: {e}")))?;
-    Ok(truth_root(mu, f))
-}
-
-/// ln|mu|, the frequency and the continuous-time pole of a truth multiplier and its frequency.
-fn truth_root(mu: DominantMultiplier, f: f64) -> (f64, f64, Complex64) {
+    .map_err(|e| {
+        GapError::Model(format!(
+            "truth ({root:?} multiplier) at {speed_rpm} rpm, {depth_m} m: {e}"
+        ))
+    })?;
     let lambda = Complex64::new(mu.modulus().ln() / mu.period_s, 2.0 * PI * f);
-    (mu.modulus().ln(), f, lambda)
+    Ok((mu.modulus().ln(), f, lambda))
 }
 
 /// The run order of `scenario` on the machine `nominal`: cuts at `scenario.speeds` random
@@ -739,12 +740,12 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
         match test.kind {
             PlannedKind::Cut => {
                 let jittered = depth_m * (scenario.label_width_log_depth * normal()).exp();
-                let (ln_mu, _, _) = truth_at(&model, speed_rpm, jittered)?;
+                let (ln_mu, _, _) = truth_at(&model, speed_rpm, jittered, TruthRoot::Dominant)?;
                 let stable = ln_mu < 0.0;
                 let chatter_hz = if stable {
                     None
                 } else {
-                    let (_, f, _) = truth_at(&model, speed_rpm, depth_m)?;
+                    let (_, f, _) = truth_at(&model, speed_rpm, depth_m, TruthRoot::Dominant)?;
                     Some(f * (1.0 + scenario.chatter_jitter_relative * normal()))
                 };
                 obs.cuts.push(Cut {
@@ -759,11 +760,12 @@ pub fn synthesize(nominal: &ModalModel, scenario: &Scenario) -> Result<Observati
                 });
             }
             PlannedKind::Pole { .. } => {
-                let (_, _, lambda) = if milling {
-                    truth_at(&model, speed_rpm, depth_m)?
+                let root = if milling {
+                    TruthRoot::Dominant
                 } else {
-                    truth_resonance_at(&model, speed_rpm, depth_m)?
+                    TruthRoot::Resonance
                 };
+                let (_, _, lambda) = truth_at(&model, speed_rpm, depth_m, root)?;
                 let tau = model.operation().delay_s(speed_rpm);
                 // a lifted pole: the principal value of ln(mu) / tau
                 let lambda = if milling {

@@ -120,13 +120,13 @@ fn failed(detail: String) -> StabilityError {
 }
 
 impl Monodromy {
-    /// The eigenvalue of largest modulus that `accept` takes, with its eigenvector, by deflation
-    /// of the larger ones (module docs). An error when the solver fails, or when more than
-    /// 40 (`MAX_DEFLATED`) rejected multipliers lie above it.
-    pub fn dominant_eigenpair_where(
+    /// What `accept` makes of the eigenpair of largest modulus it takes (it returns `None` for
+    /// the ones it rejects), by deflation of the larger ones (module docs). An error when the
+    /// solver fails, or when more than [`MAX_DEFLATED`] rejected multipliers lie above it.
+    pub fn dominant_eigenpair_where<T>(
         &self,
-        accept: impl Fn(Complex<f64>, &[Complex<f64>]) -> bool,
-    ) -> Result<(Complex<f64>, Vec<Complex<f64>>)> {
+        accept: impl Fn(Complex<f64>, &[Complex<f64>]) -> Option<T>,
+    ) -> Result<T> {
         let d = self.dimension();
         let mut deflated: Vec<Deflated> = Vec::new();
         loop {
@@ -136,8 +136,8 @@ impl Monodromy {
             };
             let (mu, right) =
                 robust_eigenpair(apply, d, || deflated_dense(self, &deflated, false), None)?;
-            if accept(mu, &right) {
-                return Ok((mu, right));
+            if let Some(accepted) = accept(mu, &right) {
+                return Ok(accepted);
             }
             if deflated.len() == MAX_DEFLATED {
                 return Err(failed(format!(
@@ -205,11 +205,13 @@ impl Discretization {
             .iter()
             .map(|m| m.frequency_hz())
             .fold(f64::INFINITY, f64::min);
-        let (mu, vector) = op.dominant_eigenpair_where(|mu, vector| {
-            !near_harmonic(mu)
-                && op.multiplier_and_frequency(model, mu, vector).1 >= SUBSTRUCTURAL * lowest_hz
-        })?;
-        Ok(op.multiplier_and_frequency(model, mu, &vector))
+        op.dominant_eigenpair_where(|mu, vector| {
+            if near_harmonic(mu) {
+                return None;
+            }
+            let (multiplier, f) = op.multiplier_and_frequency(model, mu, vector);
+            (f >= SUBSTRUCTURAL * lowest_hz).then_some((multiplier, f))
+        })
     }
 }
 
@@ -248,7 +250,9 @@ mod tests {
                 .unwrap();
             deflated += usize::from(near_harmonic(*largest));
             let (mu, vector) = op
-                .dominant_eigenpair_where(|mu, _| !near_harmonic(mu))
+                .dominant_eigenpair_where(|mu, vector| {
+                    (!near_harmonic(mu)).then(|| (mu, vector.to_vec()))
+                })
                 .unwrap();
             assert!(
                 (mu.norm() - expected.norm()).abs() < 1e-9,
