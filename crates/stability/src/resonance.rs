@@ -122,7 +122,7 @@ fn failed(detail: String) -> StabilityError {
 impl Monodromy {
     /// What `accept` makes of the eigenpair of largest modulus it takes (it returns `None` for
     /// the ones it rejects), by deflation of the larger ones (module docs). An error when the
-    /// solver fails, or when more than [`MAX_DEFLATED`] rejected multipliers lie above it.
+    /// solver fails, or when more than `MAX_DEFLATED` (40) rejected multipliers lie above it.
     pub fn dominant_eigenpair_where<T>(
         &self,
         accept: impl Fn(Complex<f64>, &[Complex<f64>]) -> Option<T>,
