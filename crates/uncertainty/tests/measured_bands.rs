@@ -37,6 +37,27 @@ fn perturbed_model(model: &ModalModel, g: f64, e: f64) -> ModalModel {
     file.validate().unwrap()
 }
 
+/// The test's uncertainty (gain sd 5 %, frequency-axis sd 1 %) and the bands of its ensemble
+/// (DRAWS members, SEED, coverage 2) for `model`'s process on the measured `nominal`.
+fn ensemble_bands(
+    model: &ModalModel,
+    nominal: &SampledReceptance,
+    speeds: &[f64],
+) -> (FrfUncertainty, EnsembleBands) {
+    let uncertainty = FrfUncertainty::new(0.05, 0.01).unwrap();
+    let ensemble = frf_ensemble(nominal, uncertainty, DRAWS, SEED).unwrap();
+    let bands = measured_type_b_bands(
+        model.operation(),
+        model.cutting(),
+        nominal,
+        &ensemble,
+        speeds,
+        2.0,
+    )
+    .unwrap();
+    (uncertainty, bands)
+}
+
 /// Sample standard deviation.
 fn sd(v: &[f64]) -> f64 {
     let n = v.len() as f64;
@@ -86,18 +107,8 @@ fn frf_bands_equal_the_modal_bands_of_the_same_draws() {
     // 1 Hz to three times the mode (20 points per half-power bandwidth 2 zeta f_n = 45 Hz)
     let grid: Vec<f64> = (1..=2250).map(|k| k as f64).collect();
     let nominal: SampledReceptance = model.sampled_receptance(grid).unwrap();
-    let uncertainty = FrfUncertainty::new(0.05, 0.01).unwrap();
     let speeds: Vec<f64> = (0..=160).map(|i| 4500.0 + 50.0 * i as f64).collect();
-    let ensemble = frf_ensemble(&nominal, uncertainty, DRAWS, SEED).unwrap();
-    let frf = measured_type_b_bands(
-        model.operation(),
-        model.cutting(),
-        &nominal,
-        &ensemble,
-        &speeds,
-        2.0,
-    )
-    .unwrap();
+    let (uncertainty, frf) = ensemble_bands(&model, &nominal, &speeds);
     // the modal route: the same draws on the modal model, lobes by zoa_lobes
     let draws = uncertainty.draws(DRAWS, SEED);
     let members: Vec<Vec<LobePoint>> = draws
@@ -185,18 +196,8 @@ fn real_cutpro_frf_bands() {
             .collect(),
     )
     .unwrap();
-    let uncertainty = FrfUncertainty::new(0.05, 0.01).unwrap();
     let speeds: Vec<f64> = (0..=120).map(|i| 4500.0 + 25.0 * i as f64).collect();
-    let ensemble = frf_ensemble(&nominal, uncertainty, DRAWS, SEED).unwrap();
-    let bands = measured_type_b_bands(
-        model.operation(),
-        model.cutting(),
-        &nominal,
-        &ensemble,
-        &speeds,
-        2.0,
-    )
-    .unwrap();
+    let (uncertainty, bands) = ensemble_bands(&model, &nominal, &speeds);
     let (pocket, exact) = check_against_exact(&bands, &uncertainty.draws(DRAWS, SEED));
     let s = bands.pocket.0;
     eprintln!(
