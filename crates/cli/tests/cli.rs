@@ -746,6 +746,20 @@ fn oma_identifies_the_signals_of_an_observations_file() {
     }
 }
 
+/// `dir/obs.json`: observations with one signal record, `file` plus the JSON `fields`.
+fn one_signal_observations(dir: &Path, file: &Path, fields: &str) -> PathBuf {
+    let obs = dir.join("obs.json");
+    std::fs::write(
+        &obs,
+        format!(
+            r#"{{ "signals": [ {{ "file": {:?}, {fields} }} ] }}"#,
+            file.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    obs
+}
+
 fn real_data(path: &str) -> Option<PathBuf> {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -1000,16 +1014,11 @@ fn oma_refuses_the_real_chatter_record() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let obs = dir.path().join("obs.json");
-    std::fs::write(
-        &obs,
-        format!(
-            r#"{{ "signals": [ {{ "file": {:?}, "speed_rpm": 5000, "depth_mm": 2.6,
-                 "sample_rate_hz": 10000 }} ] }}"#,
-            record.to_str().unwrap()
-        ),
-    )
-    .unwrap();
+    let obs = one_signal_observations(
+        dir.path(),
+        &record,
+        r#""speed_rpm": 5000, "depth_mm": 2.6, "sample_rate_hz": 10000"#,
+    );
     let off = |f: f64, base: f64| (f - (f / base).round().max(1.0) * base).abs();
     let detect = ["detect", "--observations", obs.to_str().unwrap()];
     let out = succeed(chatter().args(detect));
@@ -1063,16 +1072,11 @@ fn detect_estimates_the_speed_of_a_sound_clip() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let obs = dir.path().join("obs.json");
-    std::fs::write(
-        &obs,
-        format!(
-            r#"{{ "signals": [ {{ "file": {:?}, "speed_rpm": 1000, "depth_mm": 1,
-                 "quantity": "sound" }} ] }}"#,
-            clip.to_str().unwrap()
-        ),
-    )
-    .unwrap();
+    let obs = one_signal_observations(
+        dir.path(),
+        &clip,
+        r#""speed_rpm": 1000, "depth_mm": 1, "quantity": "sound""#,
+    );
     let out = succeed(chatter().args([
         "detect",
         "--estimate-speed",
