@@ -777,7 +777,7 @@ fn validation_of(validation: &str, folds: usize) -> PyResult<chatter_gap::Valida
 /// (`verdict`, `classes` with `log_evidence` in nats and fitted parameters, `regions`,
 /// `residuals`, ...) plus `diagnosed_model`.
 #[pyfunction]
-#[pyo3(signature = (model, observations, seed, samples=120, validation="kfold", folds=3))]
+#[pyo3(signature = (model, observations, seed, samples=120, validation="kfold", folds=3, pointwise=true))]
 fn diagnose<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -786,6 +786,7 @@ fn diagnose<'py>(
     samples: usize,
     validation: &str,
     folds: usize,
+    pointwise: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = model_of(model)?;
     let o = observations_of(observations)?;
@@ -793,6 +794,7 @@ fn diagnose<'py>(
         seed,
         samples,
         validation: validation_of(validation, folds)?,
+        pointwise,
     };
     let diagnosis = run_detached(py, move || {
         chatter_jobs::diagnose::diagnose(&m, &o, &request, &chatter_gap::diagnose::Quiet)
@@ -811,6 +813,11 @@ fn diagnose<'py>(
             "posterior_samples",
             matrix(py, &c.posterior.samples, width)?,
         )?;
+        if pointwise {
+            entry.set_item("prior_draws", matrix(py, &c.posterior.prior_draws, width)?)?;
+            let n = c.posterior.log_likelihood.first().map_or(0, Vec::len);
+            entry.set_item("log_likelihood", matrix(py, &c.posterior.log_likelihood, n)?)?;
+        }
     }
     out.set_item(
         "diagnosed_model",

@@ -113,7 +113,7 @@ def test_simulated_cuts_are_detected_stable_below_and_chatter_above_the_limit():
 def seed000_update(cli, tmp_path_factory):
     out = tmp_path_factory.mktemp("update")
     cli("update", "--model", TURNING_MODEL, "--observations", TURNING_OBSERVATIONS,
-        "--samples", 200, "--seed", 7, "--out", out)
+        "--samples", 200, "--seed", 7, "--out", out, "--netcdf")
     py = chatter.update(TURNING_MODEL, TURNING_OBSERVATIONS, seed=7, samples=200)
     return out, py
 
@@ -207,6 +207,20 @@ def test_update_inference_data_has_posterior_prior_and_pointwise_log_likelihood(
     assert idata.attrs["selected_alpha"] == py["selected_alpha"]
 
 
+def test_the_cli_netcdf_is_the_python_inference_data(seed000_update):
+    az = pytest.importorskip("arviz")
+    out, py = seed000_update
+    cli_idata = az.from_netcdf(out / "inference_data.nc")
+    idata = chatter.update_inference_data(py)
+    for group in ("posterior", "prior", "log_likelihood"):
+        a, b = cli_idata[group], idata[group]
+        assert list(a.data_vars) == list(b.data_vars), group
+        for name in a.data_vars:
+            assert same(a[name].values, b[name].values), (group, name)
+    assert cli_idata.attrs["selected_alpha"] == py["selected_alpha"]
+    assert cli_idata.attrs["log_evidence"] == idata.attrs["log_evidence"]
+
+
 def test_diagnosis_inference_data_holds_each_class_posterior():
     pytest.importorskip("arviz")
     model, observations = chatter.synthetic_campaign("process_damping", 2.0, seed=5, cuts=8,
@@ -217,6 +231,11 @@ def test_diagnosis_inference_data_holds_each_class_posterior():
     for c in d["classes"]:
         idata = by_class[c["name"]]
         assert idata.attrs["log_evidence"] == c["log_evidence"]
+        # prior draws and one pointwise log-likelihood column per cut (no poles here)
+        assert {"posterior", "prior", "log_likelihood"} <= set(idata.groups())
+        draws = len(c["posterior_samples"])
+        assert idata.log_likelihood["y"].values.shape == (1, draws, len(observations["cuts"]))
+        assert idata.prior[c["posterior_parameter_names"][0]].values.shape == (1, draws)
         for name, summary in c["parameters"].items():
             # the report's mean and the InferenceData's: the same samples summed two ways
             assert float(idata.posterior[name].mean()) == pytest.approx(summary["mean"],

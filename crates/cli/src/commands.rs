@@ -454,6 +454,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             folds: 3,
             out: Some(&folder.path_of("diagnosis")),
             report: None,
+            netcdf: false,
             quiet,
         },
     )?;

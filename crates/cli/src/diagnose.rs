@@ -6,6 +6,7 @@ use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
 use chatter_gap::{Diagnosis, DiagnosisObserver, EffectClass, Validation};
 use chatter_jobs::diagnose::{DiagnoseRequest as JobRequest, diagnose};
+use chatter_jobs::inference_data::{Draws, InferenceData};
 use plotters::style::{BLUE, RED};
 use std::io::Write;
 use std::path::Path;
@@ -33,6 +34,8 @@ pub struct DiagnoseRequest<'a> {
     pub out: Option<&'a Path>,
     /// HTML report page.
     pub report: Option<&'a Path>,
+    /// Every class's InferenceData netCDF under `out`.
+    pub netcdf: bool,
     pub quiet: bool,
 }
 
@@ -78,8 +81,9 @@ impl DiagnosisObserver for Progress {
 pub type Files = Vec<(String, Vec<u8>)>;
 
 /// What `--out` of `chatter diagnose` may hold.
-pub const FILES: [&str; 5] = [
+pub const FILES: [&str; 6] = [
     "diagnosis.json",
+    "inference_data",
     "diagnosed_model.json",
     "diagnosed_effects.json",
     "lobes.svg",
@@ -132,6 +136,7 @@ pub fn report_of(
         seed: r.seed,
         samples: r.samples,
         validation,
+        pointwise: r.netcdf,
     };
     chatter_jobs::diagnose::check(observations, &request).map_err(crate::job_error)?;
     let folds = if validation == Validation::Off {
@@ -197,6 +202,30 @@ pub fn report_of(
             "residuals.svg".into(),
             residual_map(&diagnosis)?.into_bytes(),
         ));
+        if r.netcdf {
+            for c in &diagnosis.classes {
+                let p = &c.posterior;
+                let data = InferenceData {
+                    posterior: Draws {
+                        names: &p.parameter_names,
+                        rows: &p.samples,
+                    },
+                    prior: Some(Draws {
+                        names: &p.parameter_names,
+                        rows: &p.prior_draws,
+                    }),
+                    log_likelihood: Some(&p.log_likelihood),
+                    attributes: vec![
+                        ("log_evidence", c.log_evidence),
+                        ("probability", c.probability),
+                    ],
+                };
+                files.push((
+                    format!("inference_data/{}.nc", c.name),
+                    data.to_netcdf().map_err(crate::job_error)?,
+                ));
+            }
+        }
     }
     let json = serde_json::to_string_pretty(&report)?;
     Ok((diagnosis, json, files))

@@ -234,6 +234,11 @@ enum Command {
         /// One self-contained HTML page: inputs, plots, numbers, verdict, warnings.
         #[arg(long)]
         report: Option<PathBuf>,
+        /// Also write `inference_data/CLASS.nc` under --out for every class: its posterior,
+        /// prior draws and pointwise log-likelihood (cuts, then poles) as an ArviZ
+        /// InferenceData netCDF-4 file (`arviz.from_netcdf`).
+        #[arg(long, requires = "out")]
+        netcdf: bool,
     },
     /// Sensitivity |d mu / d theta| of the dominant pole at one cut (000 Table 3) as JSON, on
     /// the one-step map of the full discretization (or the period map).
@@ -437,6 +442,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             folds,
             out,
             report,
+            netcdf,
         } => diagnose::run(
             &diagnose::DiagnoseRequest {
                 model: &model,
@@ -447,6 +453,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 folds: folds.unwrap_or(3),
                 out: out.as_deref(),
                 report: report.as_deref(),
+                netcdf,
                 quiet,
             },
             folds.is_some(),

@@ -5,6 +5,7 @@ use crate::output::Folder;
 use crate::progress::Bar;
 use anyhow::{Context, Result, anyhow, bail};
 use chatter_bayes::tmcmc::SamplerObserver;
+use chatter_jobs::inference_data::{Draws, InferenceData};
 use chatter_jobs::update::{PreparedUpdate, UpdateRequest};
 use chatter_updating::classes::{ClassObserver, Sampler};
 use chatter_updating::parameters::parse_model_parameters;
@@ -66,6 +67,11 @@ pub struct UpdateArgs {
     /// One self-contained HTML page: inputs, plots, numbers, verdict, warnings.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Also write `inference_data.nc`: the selected class's posterior, prior draws and pointwise
+    /// log-likelihood as an ArviZ InferenceData netCDF-4 file (`arviz.from_netcdf`); needs an
+    /// equally weighted sampler (itmcmc, tmcmc).
+    #[arg(long)]
+    netcdf: bool,
 }
 
 /// Likelihood evaluation of milling poles.
@@ -99,8 +105,9 @@ impl ClassObserver for ClassProgress {
 }
 
 /// What `--out` of `chatter update` may hold.
-pub const FILES: [&str; 6] = [
+pub const FILES: [&str; 7] = [
     "posterior.csv",
+    "inference_data.nc",
     "poles.csv",
     "summary.json",
     "updated_model.json",
@@ -175,6 +182,12 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             Some(SurrogateArg::Exact) => None,
         },
     };
+    if args.netcdf && matches!(args.sampler, SamplerArg::Amcmc) {
+        bail!(
+            "--netcdf with --sampler amcmc: its samples carry unequal weights, while ArviZ takes \
+             every draw as equally weighted; expected --sampler itmcmc or tmcmc"
+        );
+    }
     let job = PreparedUpdate::new(&model, &observations, request).map_err(crate::job_error)?;
     crate::validate::observation_work_size(&model, &observations, &args.observations)?;
     let progress = ClassProgress(Bar::new(
@@ -211,6 +224,36 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     }
     for p in &result.prior_bound_pileups {
         eprintln!("warning: {}", crate::report::jobs::pileup_warning(p));
+    }
+    let mut folder = folder;
+    if args.netcdf {
+        let samples = result.samples.samples();
+        let pointwise = job
+            .job()
+            .pointwise_log_likelihood(result.selected_alpha, samples)
+            .map_err(crate::job_error)?;
+        let selected = result
+            .classes
+            .iter()
+            .find(|c| c.alpha == result.selected_alpha);
+        let mut attributes = vec![("selected_alpha", result.selected_alpha.unwrap_or(f64::NAN))];
+        attributes.extend(selected.map(|c| ("log_evidence", c.log_evidence)));
+        let data = InferenceData {
+            posterior: Draws {
+                names: &result.parameter_names,
+                rows: samples,
+            },
+            prior: Some(Draws {
+                names: &result.parameter_names,
+                rows: &outcome.prior_draws,
+            }),
+            log_likelihood: Some(&pointwise),
+            attributes,
+        };
+        folder.add(
+            "inference_data.nc",
+            data.to_netcdf().map_err(crate::job_error)?,
+        );
     }
     let figures = write_outputs(folder, &result, &model, &outcome.prior_draws)?;
     match &args.report {

@@ -50,6 +50,28 @@ fn update(
     command
 }
 
+/// The posterior variables (by name) and the pointwise log-likelihood `y` (flattened) of an
+/// ArviZ InferenceData netCDF file, with its `prior` group checked to hold the same variables.
+fn inference_data(path: &Path) -> (std::collections::BTreeMap<String, Vec<f64>>, Vec<f64>) {
+    let file = netcdf_reader::NcFile::open(path).unwrap();
+    let read = |name: &str| -> Vec<f64> {
+        file.read_variable_as_f64(name)
+            .unwrap()
+            .iter()
+            .copied()
+            .collect()
+    };
+    let group = file.group("posterior").unwrap();
+    let mut posterior = std::collections::BTreeMap::new();
+    for v in &group.variables {
+        if v.name() != "chain" && v.name() != "draw" {
+            posterior.insert(v.name().to_string(), read(&format!("posterior/{}", v.name())));
+            assert!(!read(&format!("prior/{}", v.name())).is_empty());
+        }
+    }
+    (posterior, read("log_likelihood/y"))
+}
+
 fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -370,10 +392,22 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
             .arg("--observations")
             .arg(&obs_path)
             .arg("--out")
-            .arg(&out_dir),
+            .arg(&out_dir)
+            .arg("--netcdf"),
     );
     let report: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(report["verdict"], "process_damping", "{report}");
+    // every class as an ArviZ InferenceData file: posterior, prior and one pointwise
+    // log-likelihood column per observation, read back by an independent netCDF decoder
+    let observations = data.cuts.len() + data.poles.len();
+    for class in EffectClass::ALL {
+        let (posterior, log_likelihood) =
+            inference_data(&out_dir.join(format!("inference_data/{class}.nc")));
+        let draws = posterior["frequency_factor"].len();
+        assert!(draws >= 120, "{class}: {draws} draws");
+        assert_eq!(log_likelihood.len(), draws * observations, "{class}");
+        assert!(log_likelihood.iter().all(|v| v.is_finite() && *v <= 10.0), "{class}");
+    }
     let classes = report["classes"].as_array().unwrap();
     assert_eq!(classes.len(), 5);
     let total: f64 = classes
@@ -466,7 +500,7 @@ fn update_writes_posterior_summary_model_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("posterior");
     succeed(&mut update(
-        &["--classes", "0.5,1", "--samples", "200", "--seed", "3"],
+        &["--classes", "0.5,1", "--samples", "200", "--seed", "3", "--netcdf"],
         example("ahmadi2022_turning_model.json"),
         example("ahmadi2022_turning_observations.json"),
         &out_dir,
@@ -500,6 +534,19 @@ fn update_writes_posterior_summary_model_and_plots() {
     let csv = std::fs::read_to_string(out_dir.join("posterior.csv")).unwrap();
     assert!(csv.starts_with("theta_omega_2,theta_zeta_2,theta_phi_2,sigma_r2,weight\n"));
     assert_eq!(csv.lines().count(), 201);
+    // --netcdf: the same samples as an ArviZ InferenceData file, read back by an independent
+    // netCDF decoder; one pointwise log-likelihood column per identified pole repetition
+    let (posterior, log_likelihood) = inference_data(&out_dir.join("inference_data.nc"));
+    for (k, name) in names.iter().enumerate() {
+        let column: Vec<f64> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(posterior[*name], column, "{name}");
+    }
+    assert_eq!(log_likelihood.len() % 200, 0);
+    assert!(log_likelihood.len() >= 200 && log_likelihood.iter().all(|v| v.is_finite()));
     for plot in ["evidence.svg", "corner.svg"] {
         let svg = std::fs::read_to_string(out_dir.join(plot)).unwrap();
         assert!(svg.contains("<svg"), "{plot}");

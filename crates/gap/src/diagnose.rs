@@ -10,12 +10,14 @@ use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
 use crate::shrink::{Shrink, ValidationReport, shrink};
 use crate::variant::Variant;
+use chatter_bayes::Prior;
 use chatter_bayes::tmcmc::{
     Silent, TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, rejuvenate, tmcmc,
 };
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::Discretization;
+use rand::SeedableRng;
 use rayon::prelude::*;
 use serde::{Serialize, Serializer};
 use std::collections::BTreeMap;
@@ -62,6 +64,10 @@ pub struct DiagnoseOptions {
     pub validation_samples: usize,
     /// The candidate classes (`parameter_error` is always added).
     pub classes: Vec<EffectClass>,
+    /// Also give every class's prior draws and pointwise log-likelihood
+    /// ([`ClassPosterior::prior_draws`], [`ClassPosterior::log_likelihood`]) for ArviZ's LOO /
+    /// WAIC: one more prediction per posterior sample.
+    pub pointwise: bool,
 }
 
 impl Default for DiagnoseOptions {
@@ -94,6 +100,7 @@ impl Default for DiagnoseOptions {
             validation: Validation::KFold { folds: 3 },
             validation_samples: 80,
             classes: EffectClass::ALL.to_vec(),
+            pointwise: false,
         }
     }
 }
@@ -275,6 +282,14 @@ pub struct ClassPosterior {
     pub parameter_names: Vec<String>,
     /// One row per equally weighted iTMCMC sample.
     pub samples: Vec<Vec<f64>>,
+    /// With [`DiagnoseOptions::pointwise`]: as many draws from the class's prior, in the same
+    /// parameters (seeded by the diagnosis's seed); otherwise empty.
+    pub prior_draws: Vec<Vec<f64>>,
+    /// With [`DiagnoseOptions::pointwise`]: ln p(y_i | theta_s) (nats), one row per sample of
+    /// `samples` and one column per observation: the cuts in the order given (label and chatter
+    /// frequency together), then the poles (frequency and damping together). The row sums are
+    /// the samples' log-likelihoods. Otherwise empty.
+    pub log_likelihood: Vec<Vec<f64>>,
 }
 
 /// Share of failed evaluations above which a class is flagged.
@@ -676,7 +691,7 @@ pub fn diagnose(
             evaluations: f.evaluations,
             solver_failures: f.failures,
             failures_flagged: f.failures as f64 > MAX_FAILURE_RATE * f.evaluations.max(1) as f64,
-            posterior: posterior(f),
+            posterior: posterior(f, &data, &options),
         })
         .collect();
     let (diagnosed, diagnosed_prediction) = if consistent {
@@ -737,10 +752,12 @@ fn physical_samples(f: &Fitted) -> Vec<Vec<(&'static str, f64)>> {
         .collect()
 }
 
-/// The class's samples in physical parameters.
-fn posterior(f: &Fitted) -> ClassPosterior {
+/// The class's samples in physical parameters, with its prior draws and pointwise
+/// log-likelihood when `options.pointwise` is set.
+fn posterior(f: &Fitted, data: &Dataset, options: &DiagnoseOptions) -> ClassPosterior {
     let rows = physical_samples(f);
-    ClassPosterior {
+    let values = |t: &[f64]| -> Vec<f64> { f.model.physical(t).iter().map(|(_, v)| *v).collect() };
+    let mut out = ClassPosterior {
         parameter_names: rows
             .first()
             .map(|r| r.iter().map(|(n, _)| (*n).to_string()).collect())
@@ -749,7 +766,40 @@ fn posterior(f: &Fitted) -> ClassPosterior {
             .iter()
             .map(|r| r.iter().map(|(_, v)| *v).collect())
             .collect(),
+        ..ClassPosterior::default()
+    };
+    if options.pointwise {
+        let samples = f.run.samples.samples();
+        let seed = class_seed(options.seed, f.model.class, usize::MAX - 1);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        out.prior_draws = (0..samples.len())
+            .map(|_| values(&f.model.prior.sample(&mut rng)))
+            .collect();
+        out.log_likelihood = samples
+            .par_iter()
+            .map(|t| pointwise_log_likelihood(&f.model, data, &options.noise, t))
+            .collect();
     }
+    out
+}
+
+/// ln p(y_i | theta) of every observation (cuts, then poles) for a class at `theta`; -inf for
+/// every observation outside the physical support.
+fn pointwise_log_likelihood(
+    model: &ClassModel,
+    data: &Dataset,
+    noise: &NoiseModel,
+    theta: &[f64],
+) -> Vec<f64> {
+    let n = data.cuts.len() + data.poles.len();
+    let Some(v) = model.variant(theta) else {
+        return vec![f64::NEG_INFINITY; n];
+    };
+    let t = terms(&predict(&v, data), data, noise);
+    (0..data.cuts.len())
+        .map(|i| t.cut(i))
+        .chain((0..data.poles.len()).map(|i| t.pole(i)))
+        .collect()
 }
 
 /// Posterior mean and standard deviation of every physical parameter of a fitted class.
@@ -772,4 +822,49 @@ fn summaries(f: &Fitted) -> BTreeMap<String, ParameterSummary> {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generator::{effect_at, proving_machines};
+    use crate::{Scenario, synthesize};
+
+    /// The pointwise log-likelihood of a draw sums to the log-likelihood the sampler uses, for
+    /// every class on the lathe (cuts with chatter frequencies and poles).
+    #[test]
+    fn pointwise_terms_sum_to_the_log_likelihood() {
+        let machine = &proving_machines().unwrap()[3];
+        let (lo, hi) = machine.speed_range_rpm;
+        let (effect, error) = effect_at(
+            EffectClass::ParameterError,
+            1.0,
+            &machine.model,
+            machine.speed_range_rpm,
+        )
+        .unwrap();
+        let mut scenario = Scenario::new(effect, 7).with_speed_range(lo, hi, 2);
+        scenario.error = error;
+        scenario.cuts = 10;
+        let observations = synthesize(&machine.model, &scenario).unwrap();
+        let noise = NoiseModel::default();
+        let prepared = prepare(&machine.model, &observations, &noise).unwrap();
+        let n = observations.cuts.len() + observations.poles.len();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        for class in EffectClass::ALL {
+            let model = ClassModel::new(class, &prepared.nominal).unwrap();
+            for _ in 0..3 {
+                let theta = model.prior.sample(&mut rng);
+                let count = FailureCount::default();
+                let total = log_likelihood(&model, &prepared.data, &noise, &theta, &count);
+                let terms = pointwise_log_likelihood(&model, &prepared.data, &noise, &theta);
+                assert_eq!(terms.len(), n);
+                let sum: f64 = terms.iter().sum();
+                assert!(
+                    (sum - total).abs() <= 1e-9 * total.abs().max(1.0),
+                    "{class}: {sum} against {total}"
+                );
+            }
+        }
+    }
 }

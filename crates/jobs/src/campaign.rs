@@ -175,6 +175,7 @@ pub fn campaign_row(
         seed,
         samples: options.samples,
         validation: options.validation,
+        pointwise: false,
     };
     let diagnosis = diagnose(model, observations, &request, &chatter_gap::diagnose::Quiet)?;
     let mut speeds = observations.speeds_rpm();

@@ -19,6 +19,8 @@ pub struct DiagnoseRequest {
     pub samples: usize,
     /// Held-out validation.
     pub validation: Validation,
+    /// Every class's prior draws and pointwise log-likelihood too (for ArviZ).
+    pub pointwise: bool,
 }
 
 impl DiagnoseRequest {
@@ -30,6 +32,7 @@ impl DiagnoseRequest {
             validation: Validation::KFold {
                 folds: DEFAULT_FOLDS,
             },
+            pointwise: false,
         }
     }
 
@@ -55,6 +58,7 @@ pub fn diagnose(
         seed: request.seed,
         samples: request.samples,
         validation: request.validation,
+        pointwise: request.pointwise,
         ..DiagnoseOptions::default()
     };
     Ok(chatter_gap::diagnose(

@@ -9,11 +9,13 @@
 //! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
 //! - [`bands`]: lobes, Type B offsets (001), credibility bounds (000), Monte Carlo (004).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
+//! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
 
 pub mod bands;
 pub mod campaign;
 pub mod diagnose;
 pub mod error;
+pub mod inference_data;
 pub mod plan;
 pub mod update;
 

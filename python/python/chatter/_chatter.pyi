@@ -147,10 +147,12 @@ def diagnose(
     samples: int = 120,
     validation: str = "kfold",
     folds: int = 3,
+    pointwise: bool = True,
 ) -> dict:
     """Sim-to-real gap diagnosis (the ``chatter diagnose`` job, ``diagnosis.json`` contents):
-    ``verdict``, ``classes`` (with ``posterior_parameter_names``, ``posterior_samples``),
-    ``regions``, ``residuals``, ``diagnosed_model``, ..."""
+    ``verdict``, ``classes`` (with ``posterior_parameter_names``, ``posterior_samples`` and,
+    with ``pointwise``, ``prior_draws`` and ``log_likelihood`` in nats, one column per cut then
+    pole), ``regions``, ``residuals``, ``diagnosed_model``, ..."""
 
 def read_manifest(manifest: Union[str, PathLike]) -> list[dict]:
     """Campaigns of a fleet manifest (``name``, ``model``, ``observations``, ``seed``)."""

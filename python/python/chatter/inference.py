@@ -60,8 +60,13 @@ def update_inference_data(result: dict, seed: int = 0):
 
 def diagnosis_inference_data(diagnosis: dict) -> dict:
     """One ``arviz.InferenceData`` per effect class of a :func:`chatter.diagnose` result, keyed
-    by class name, from the class's ``posterior_samples`` (one chain; variables named as the
-    class's fitted parameters) and ``log_evidence`` (nats) as an attribute."""
+    by class name: ``posterior`` from the class's ``posterior_samples`` (one chain; variables
+    named as the class's fitted parameters, units in the names), and when the diagnosis was run
+    with ``pointwise=True`` (the default) ``prior`` (the class's prior draws) and
+    ``log_likelihood`` (variable ``y``, nats, one column per observation: the cuts in the order
+    given, then the poles) for LOO / WAIC; ``log_evidence`` (nats) and ``probability`` as
+    attributes. ``chatter diagnose --out DIR --netcdf`` writes the same groups to
+    ``DIR/inference_data/CLASS.nc``."""
     import arviz as az
 
     out = {}
@@ -72,8 +77,16 @@ def diagnosis_inference_data(diagnosis: dict) -> dict:
         names = list(c["posterior_parameter_names"])
         s = np.asarray(samples, dtype=float)
         posterior = {n: s[None, :, k] for k, n in enumerate(names)}
+        kwargs = {}
+        if "prior_draws" in c:
+            p = np.asarray(c["prior_draws"], dtype=float)
+            kwargs["prior"] = {n: p[None, :, k] for k, n in enumerate(names)}
+        if "log_likelihood" in c:
+            kwargs["log_likelihood"] = {"y": np.asarray(c["log_likelihood"])[None, :, :]}
+            kwargs["dims"] = {"y": ["observation"]}
         out[c["name"]] = az.from_dict(
             posterior=posterior,
             attrs={"log_evidence": float(c["log_evidence"]), "probability": float(c["probability"])},
+            **kwargs,
         )
     return out
