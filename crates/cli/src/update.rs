@@ -230,8 +230,7 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
         let samples = result.samples.samples();
         let pointwise = job
             .job()
-            .pointwise_log_likelihood(result.selected_alpha, samples)
-            .map_err(crate::job_error)?;
+            .pointwise_log_likelihood(result.selected_alpha, samples)?;
         let selected = result
             .classes
             .iter()
