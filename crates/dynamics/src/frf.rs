@@ -1,11 +1,25 @@
 //! Receptance frequency response functions.
 //!
 //! G_ij(i omega) = sum_n phi_in phi_jn / (omega_n^2 - omega^2 + 2 i zeta_n omega_n omega), the
-//! displacement at coordinate i per unit force at coordinate j (m/N), from 000 Eq. 1.
+//! displacement at coordinate i per unit force at coordinate j (m/N), from 000 Eq. 1; a
+//! non-proportional mode multiplies its term by the numerator n_0 + n_1 i omega
+//! ([`crate::model::complex_mode_numerator`]).
 
-use crate::model::ModalModel;
+use crate::model::{ModalModel, Mode};
 use num_complex::Complex64;
 use std::f64::consts::PI;
+
+impl Mode {
+    /// This mode's term of G_ij at `frequency_hz` (m/N).
+    pub fn receptance(&self, frequency_hz: f64, i: usize, j: usize) -> Complex64 {
+        let w = 2.0 * PI * frequency_hz;
+        let phi = self.mass_normalized_shape();
+        let wn = self.omega_rad_s();
+        let den = Complex64::new(wn * wn - w * w, 2.0 * self.damping_ratio() * wn * w);
+        let (n0, n1) = self.receptance_numerator();
+        Complex64::new(n0, n1 * w) * (phi[i] * phi[j]) / den
+    }
+}
 
 impl ModalModel {
     /// Receptance G_ij at `frequency_hz` (m/N) between coordinate indices `i` and `j` (0 or 1).
@@ -18,15 +32,9 @@ impl ModalModel {
     /// assert!((g0.re - 1.0 / 3.0e6).abs() < 1e-15);
     /// ```
     pub fn receptance(&self, frequency_hz: f64, i: usize, j: usize) -> Complex64 {
-        let w = 2.0 * PI * frequency_hz;
         self.modes()
             .iter()
-            .map(|m| {
-                let phi = m.mass_normalized_shape();
-                let wn = m.omega_rad_s();
-                let den = Complex64::new(wn * wn - w * w, 2.0 * m.damping_ratio() * wn * w);
-                phi[i] * phi[j] / den
-            })
+            .map(|m| m.receptance(frequency_hz, i, j))
             .sum()
     }
 
