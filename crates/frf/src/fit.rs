@@ -219,7 +219,8 @@ impl ModalFit {
     /// Whether the data need non-proportional modes: the complex modes alone fit the band
     /// better than the real modes by more than [`COMPLEX_MODE_GAIN`] of the real modes' misfit.
     pub fn needs_complex_modes(&self) -> bool {
-        self.complex_mode_relative_misfit < (1.0 - COMPLEX_MODE_GAIN) * self.real_mode_relative_misfit
+        self.complex_mode_relative_misfit
+            < (1.0 - COMPLEX_MODE_GAIN) * self.real_mode_relative_misfit
     }
 }
 

@@ -206,7 +206,8 @@ impl OrientedSystem {
             let zeta = added.damping_ratio(n, m)?;
             let wn = m.omega_rad_s;
             let (n0, n1) = m.numerator;
-            let inv = Complex64::new(n0, n1 * w) / Complex64::new(wn * wn - w * w, 2.0 * zeta * wn * w);
+            let inv =
+                Complex64::new(n0, n1 * w) / Complex64::new(wn * wn - w * w, 2.0 * zeta * wn * w);
             let [p, q] = m.shape;
             g[0] += inv * (p * p);
             g[1] += inv * (p * q);
