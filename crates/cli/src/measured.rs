@@ -40,14 +40,7 @@ pub fn lobes(
     let model = MeasuredModel::from_path(model_path).context("reading the measured FRFs")?;
     let speeds = match speeds {
         Some(s) => crate::validate::speeds(s)?,
-        None => {
-            let f = model.receptance.peak_frequency_hz();
-            let n = model.operation.delays_per_revolution() as f64;
-            let max = (60.0 * f / n * 1.2).min(60_000.0);
-            (0..200)
-                .map(|i| max / 10.0 + (max - max / 10.0) * i as f64 / 199.0)
-                .collect()
-        }
+        None => default_speeds(&model),
     };
     Ok(Some(measured_limiting_depths(
         &model.operation,
@@ -57,6 +50,17 @@ pub fn lobes(
         // the depth ceiling of every `lobes` method (see `commands::warn_unbounded`)
         &ZeroOrderOptions::default(),
     )?))
+}
+
+/// 200 speeds from a tenth of to 1.2 times the speed whose tooth-passing frequency is the
+/// receptance's peak (at most 60 000 rpm).
+pub fn default_speeds(model: &MeasuredModel) -> Vec<f64> {
+    let f = model.receptance.peak_frequency_hz();
+    let n = model.operation.delays_per_revolution() as f64;
+    let max = (60.0 * f / n * 1.2).min(60_000.0);
+    (0..200)
+        .map(|i| max / 10.0 + (max - max / 10.0) * i as f64 / 199.0)
+        .collect()
 }
 
 /// Arguments of `chatter fit-frf`.
