@@ -44,6 +44,9 @@ pub struct BandRequest<'a> {
     pub depths: Option<&'a str>,
     /// Type B offsets (rpm, mm) when given (default 100 rpm, 0.2 mm).
     pub offsets: (Option<f64>, Option<f64>),
+    /// Relative gain and frequency-axis standard deviations of a measured FRF (geometric bands
+    /// on a `measured_frf` model: offsets from the FRF ensemble).
+    pub frf_sd: (Option<f64>, Option<f64>),
     /// Posterior folder.
     pub posterior: Option<&'a Path>,
     /// Covariance file.
@@ -69,9 +72,9 @@ pub struct BandRequest<'a> {
 }
 
 /// Default Type B speed offset (seed 001).
-const OFFSET_RPM: f64 = 100.0;
+pub(crate) const OFFSET_RPM: f64 = 100.0;
 /// Default Type B depth offset (seed 001).
-const OFFSET_MM: f64 = 0.2;
+pub(crate) const OFFSET_MM: f64 = 0.2;
 /// Default Monte Carlo samples.
 const SAMPLES: usize = 500;
 /// Most Monte Carlo samples.
@@ -106,13 +109,36 @@ fn check_options(req: &BandRequest) -> Result<()> {
             "--kind perturbation and montecarlo",
         )?;
     }
+    let frf_draws = crate::measured_bands::frf_uncertainty(req).is_some();
+    for (given, flag) in [
+        (req.frf_sd.0.is_some(), "--gain-sd"),
+        (req.frf_sd.1.is_some(), "--frequency-sd"),
+    ] {
+        validate::unused(given && !geometric, flag, &context, "--kind geometric")?;
+    }
+    if frf_draws && (req.offsets.0.is_some() || req.offsets.1.is_some()) {
+        bail!(
+            "--offset-rpm/--offset-mm and --gain-sd/--frequency-sd both given: the offsets are \
+             either stated or set by the FRF uncertainty; give one of the two"
+        );
+    }
     for (given, flag) in [
         (req.samples.is_some(), "--samples"),
         (req.seed.is_some(), "--seed"),
-        (req.map_out.is_some(), "--map-out"),
     ] {
-        validate::unused(given && !montecarlo, flag, &context, "--kind montecarlo")?;
+        validate::unused(
+            given && !montecarlo && !frf_draws,
+            flag,
+            &context,
+            "--kind montecarlo and the FRF draws of --gain-sd/--frequency-sd",
+        )?;
     }
+    validate::unused(
+        req.map_out.is_some() && !montecarlo,
+        "--map-out",
+        &context,
+        "--kind montecarlo",
+    )?;
     validate::unused(
         req.depths.is_some() && (geometric || (montecarlo && req.map_out.is_none())),
         "--depths",
@@ -150,6 +176,21 @@ fn check_options(req: &BandRequest) -> Result<()> {
 /// `chatter bands`.
 pub fn bands(req: &BandRequest) -> Result<()> {
     check_options(req)?;
+    let measured = chatter_frf::read_model_file(req.model)
+        .map(|f| f.measured_frf.is_some())
+        .unwrap_or(false);
+    if measured && req.kind == BandKind::Geometric && matches!(req.method, None | Some(Method::Zoa))
+    {
+        crate::measured_bands::check(req)?;
+        return crate::measured_bands::bands(req, req.model);
+    }
+    if crate::measured_bands::frf_uncertainty(req).is_some() {
+        bail!(
+            "--gain-sd/--frequency-sd: {} has no measured_frf; the FRF uncertainty applies to \
+             zero-order geometric bands of a model with measured_frf",
+            req.model.display()
+        );
+    }
     let speeds = req.speeds.map(validate::speeds).transpose()?;
     let model = inputs::model(req.model)?;
     let obs = req.observations.map(inputs::observations).transpose()?;

@@ -10,6 +10,7 @@ mod detect;
 mod diagnose;
 mod inputs;
 mod measured;
+mod measured_bands;
 mod oma;
 mod output;
 mod plan;
@@ -139,6 +140,13 @@ enum Command {
         /// Depth offset (mm), geometric; default 0.2.
         #[arg(long)]
         offset_mm: Option<f64>,
+        /// Relative standard deviation of a measured FRF's gain (geometric bands on a model with
+        /// measured_frf: the offsets become 2 sd of the lobe pocket over FRF draws).
+        #[arg(long)]
+        gain_sd: Option<f64>,
+        /// Relative standard deviation of a measured FRF's frequency axis (as --gain-sd).
+        #[arg(long)]
+        frequency_sd: Option<f64>,
         /// Posterior folder of `chatter update` (summary.json, posterior.csv).
         #[arg(long)]
         posterior: Option<PathBuf>,
@@ -363,6 +371,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             depths,
             offset_rpm,
             offset_mm,
+            gain_sd,
+            frequency_sd,
             posterior,
             covariance,
             samples,
@@ -380,6 +390,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             speeds: speeds.as_deref(),
             depths: depths.as_deref(),
             offsets: (offset_rpm, offset_mm),
+            frf_sd: (gain_sd, frequency_sd),
             posterior: posterior.as_deref(),
             covariance: covariance.as_deref(),
             samples,

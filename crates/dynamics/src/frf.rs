@@ -1,11 +1,25 @@
 //! Receptance frequency response functions.
 //!
 //! G_ij(i omega) = sum_n phi_in phi_jn / (omega_n^2 - omega^2 + 2 i zeta_n omega_n omega), the
-//! displacement at coordinate i per unit force at coordinate j (m/N), from 000 Eq. 1.
+//! displacement at coordinate i per unit force at coordinate j (m/N), from 000 Eq. 1; a
+//! non-proportional mode multiplies its term by the numerator n_0 + n_1 i omega
+//! ([`crate::model::complex_mode_numerator`]).
 
-use crate::model::ModalModel;
+use crate::model::{ModalModel, Mode};
 use num_complex::Complex64;
 use std::f64::consts::PI;
+
+impl Mode {
+    /// This mode's term of G_ij at `frequency_hz` (m/N).
+    pub fn receptance(&self, frequency_hz: f64, i: usize, j: usize) -> Complex64 {
+        let w = 2.0 * PI * frequency_hz;
+        let phi = self.mass_normalized_shape();
+        let wn = self.omega_rad_s();
+        let den = Complex64::new(wn * wn - w * w, 2.0 * self.damping_ratio() * wn * w);
+        let (n0, n1) = self.receptance_numerator();
+        Complex64::new(n0, n1 * w) * (phi[i] * phi[j]) / den
+    }
+}
 
 impl ModalModel {
     /// Receptance G_ij at `frequency_hz` (m/N) between coordinate indices `i` and `j` (0 or 1).
@@ -18,15 +32,9 @@ impl ModalModel {
     /// assert!((g0.re - 1.0 / 3.0e6).abs() < 1e-15);
     /// ```
     pub fn receptance(&self, frequency_hz: f64, i: usize, j: usize) -> Complex64 {
-        let w = 2.0 * PI * frequency_hz;
         self.modes()
             .iter()
-            .map(|m| {
-                let phi = m.mass_normalized_shape();
-                let wn = m.omega_rad_s();
-                let den = Complex64::new(wn * wn - w * w, 2.0 * m.damping_ratio() * wn * w);
-                phi[i] * phi[j] / den
-            })
+            .map(|m| m.receptance(frequency_hz, i, j))
             .sum()
     }
 
@@ -42,5 +50,89 @@ impl ModalModel {
                 self.receptance(frequency_hz, 1, 1),
             ],
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::examples;
+    use crate::model::{Mode, ModeShape};
+    use num_complex::Complex64;
+    use std::f64::consts::PI;
+
+    /// A complex mode's receptance equals the pole-residue pair written out directly,
+    /// A / (i w - lambda) + conj(A) / (i w - conj(lambda)), at every frequency; the residue
+    /// round-trips through `Mode::from_residue`.
+    #[test]
+    fn complex_mode_is_the_pole_residue_pair() {
+        let (f, zeta) = (1448.53, 0.01651);
+        let a = Complex64::new(-4.182e-5, -3.044e-4);
+        let mode = Mode::from_residue(f, zeta, 0, a).unwrap();
+        let wn = 2.0 * PI * f;
+        let lambda = Complex64::new(-zeta * wn, wn * (1.0 - zeta * zeta).sqrt());
+        for hz in [0.0, 300.0, 1400.0, 1448.53, 1500.0, 5000.0] {
+            let iw = Complex64::new(0.0, 2.0 * PI * hz);
+            let direct = a / (iw - lambda) + a.conj() / (iw - lambda.conj());
+            let ours = mode.receptance(hz, 0, 0);
+            assert!(
+                (ours - direct).norm() <= 1e-12 * direct.norm(),
+                "{hz}: {ours} vs {direct}"
+            );
+        }
+        // a real mode is the phase-0 case of the same formula
+        let real = Mode::new(
+            f,
+            zeta,
+            ModeShape::Directional {
+                coordinate: 0,
+                stiffness_n_per_m: 1e7,
+            },
+        )
+        .unwrap();
+        let back = Mode::from_residue(
+            f,
+            zeta,
+            0,
+            Complex64::new(0.0, -wn * wn / (2.0 * lambda.im * 1e7)),
+        )
+        .unwrap();
+        assert!(back.residue_phase_rad().abs() < 1e-15);
+        assert!((back.stiffness_at(0) / 1e7 - 1.0).abs() < 1e-12);
+        assert!((real.receptance(900.0, 0, 0) - back.receptance(900.0, 0, 0)).norm() < 1e-20);
+    }
+
+    #[test]
+    fn complex_modes_are_refused_where_they_are_not_defined() {
+        let model = examples::schmitz_2023_milling();
+        let m = model.modes()[0];
+        assert!(m.with_residue_phase(4.0).is_err());
+        assert!(m.with_residue_phase(f64::NAN).is_err());
+        let undamped = Mode::new(500.0, 0.0, m.shape()).unwrap();
+        assert!(undamped.with_residue_phase(0.1).is_err());
+        let complex = model
+            .with_modes(vec![m.with_residue_phase(0.3).unwrap()])
+            .unwrap();
+        let e = complex.require_proportional("FDM").unwrap_err().to_string();
+        assert!(
+            e.contains("FDM") && e.contains("modes[0].residue_phase_deg"),
+            "{e}"
+        );
+        let e = examples::ebrahimi_2025_milling();
+        let e = e
+            .with_process_damping(None)
+            .unwrap()
+            .with_modes(vec![e.modes()[0].with_residue_phase(0.3).unwrap()])
+            .unwrap()
+            .with_process_damping(Some(1e4))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("non-proportional"), "{e}");
+        // the model file keeps the phase
+        let text = complex.to_json_string();
+        let back = crate::ModalModel::from_json_str(&text, std::path::Path::new("m.json")).unwrap();
+        assert!(
+            (back.modes()[0].residue_phase_rad() - 0.3).abs() < 1e-12,
+            "{text}"
+        );
     }
 }

@@ -4,10 +4,45 @@
 //! (000 Eq. 1) with Phi the 2 x N matrix of mass-normalized mode shapes over the operation's
 //! two coordinates. A mode given by a stiffness k in one direction is the mass-normalized shape
 //! omega_n / sqrt(k) in that direction (modal mass k / omega_n^2).
+//!
+//! # Non-proportional (complex) modes
+//! A mode may carry a residue phase alpha (`residue_phase_deg` in model files; 0 for a real,
+//! proportionally damped mode). Its receptance is the complex-mode pair of Ewins (2000,
+//! Section 2.7; the pole-residue form of `chatter_frf::fit`)
+//!
+//! G_ij(i w) = A_ij / (i w - lambda) + conj(A_ij) / (i w - conj(lambda)),
+//! A_ij = e^{i alpha} phi_i phi_j / (2 i w_d),
+//!
+//! with lambda = -zeta w_n + i w_d, w_d = w_n sqrt(1 - zeta^2). At alpha = 0 this is exactly
+//! phi_i phi_j / (w_n^2 - w^2 + 2 i zeta w_n w); in general it is
+//! phi_i phi_j (n_0 + n_1 i w) / (w_n^2 - w^2 + 2 i zeta w_n w) with the numerator of
+//! [`complex_mode_numerator`]. The stiffness form k = w_n^2 / phi^2 keeps its meaning as the
+//! size of the residue, |A| = w_n^2 / (2 w_d k); the phase rotates it. Methods built on real
+//! modal coordinates (FDM, SDM, the frequency-domain poles, time-domain simulation) refuse such
+//! modes ([`ModalModel::require_proportional`]); the zero-order method uses them.
 
 use crate::error::{DynamicsError, Result, finite, non_negative, positive};
 use crate::operation::Operation;
+use num_complex::Complex64;
 use std::f64::consts::PI;
+
+/// The numerator (n_0, n_1 in s) of a complex mode's receptance over its real-mode denominator:
+/// A / (i w - lambda) + conj(A) / (i w - conj(lambda)) = phi^2 (n_0 + n_1 i w) /
+/// (w_n^2 - w^2 + 2 i zeta w_n w) for A = e^{i alpha} phi^2 / (2 i w_d) (module docs), i.e.
+/// n_0 = cos(alpha) + zeta / sqrt(1 - zeta^2) sin(alpha), n_1 = sin(alpha) / w_d. (1, 0) for a
+/// real mode.
+pub fn complex_mode_numerator(
+    omega_rad_s: f64,
+    damping_ratio: f64,
+    residue_phase_rad: f64,
+) -> (f64, f64) {
+    if residue_phase_rad == 0.0 {
+        return (1.0, 0.0);
+    }
+    let root = (1.0 - damping_ratio * damping_ratio).sqrt();
+    let (sin, cos) = residue_phase_rad.sin_cos();
+    (cos + damping_ratio / root * sin, sin / (omega_rad_s * root))
+}
 
 /// How a mode's shape (and so its modal mass or stiffness) is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +64,7 @@ pub struct Mode {
     frequency_hz: f64,
     damping_ratio: f64,
     shape: ModeShape,
+    residue_phase_rad: f64,
 }
 
 impl Mode {
@@ -73,7 +109,69 @@ impl Mode {
             frequency_hz,
             damping_ratio,
             shape,
+            residue_phase_rad: 0.0,
         })
+    }
+
+    /// The same mode made non-proportional with residue phase alpha (rad, module docs),
+    /// -pi < alpha <= pi, of a damped mode (an undamped complex mode is not physical).
+    pub fn with_residue_phase(self, residue_phase_rad: f64) -> Result<Self> {
+        finite("residue_phase_deg", residue_phase_rad)?;
+        if !(residue_phase_rad > -PI && residue_phase_rad <= PI) {
+            return Err(DynamicsError::value(
+                "residue_phase_deg",
+                residue_phase_rad.to_degrees(),
+                "a phase in (-180, 180] degrees",
+            ));
+        }
+        if residue_phase_rad != 0.0 && self.damping_ratio == 0.0 {
+            return Err(DynamicsError::invalid(
+                "residue_phase_deg",
+                "a non-proportional (complex) mode needs a damping ratio > 0",
+            ));
+        }
+        Ok(Self {
+            residue_phase_rad,
+            ..self
+        })
+    }
+
+    /// The directional mode at `coordinate` whose complex residue is `residue_m_per_n_s` (A of
+    /// the module docs, m/(N s)): k = w_n^2 / (2 w_d |A|), alpha = arg(i A). This is how a
+    /// measured FRF's pole-residue fit becomes a model mode.
+    pub fn from_residue(
+        frequency_hz: f64,
+        damping_ratio: f64,
+        coordinate: usize,
+        residue_m_per_n_s: Complex64,
+    ) -> Result<Self> {
+        let magnitude = residue_m_per_n_s.norm();
+        positive("residue_m_per_n_s", magnitude)?;
+        let wn = 2.0 * PI * frequency_hz;
+        let wd = wn * (1.0 - damping_ratio * damping_ratio).max(0.0).sqrt();
+        let alpha = (Complex64::i() * residue_m_per_n_s).arg();
+        let shape = ModeShape::Directional {
+            coordinate,
+            stiffness_n_per_m: wn * wn / (2.0 * wd * magnitude),
+        };
+        Self::new(frequency_hz, damping_ratio, shape)?.with_residue_phase(alpha)
+    }
+
+    /// Residue phase alpha (rad) of a non-proportional mode; 0 for a real mode.
+    pub fn residue_phase_rad(&self) -> f64 {
+        self.residue_phase_rad
+    }
+    /// Whether the mode is real (proportionally damped): residue phase 0.
+    pub fn is_proportional(&self) -> bool {
+        self.residue_phase_rad == 0.0
+    }
+    /// The numerator (n_0, n_1 in s) of [`complex_mode_numerator`] for this mode.
+    pub fn receptance_numerator(&self) -> (f64, f64) {
+        complex_mode_numerator(
+            self.omega_rad_s(),
+            self.damping_ratio,
+            self.residue_phase_rad,
+        )
     }
 
     /// Natural frequency in Hz.
@@ -125,6 +223,7 @@ impl Mode {
             frequency_hz,
             damping_ratio,
             shape,
+            ..self
         }
     }
 }
@@ -194,6 +293,13 @@ impl ModalModel {
         }
         if let Some(c) = process_damping_n_per_m {
             non_negative("process_damping.c_n_per_m", c)?;
+            if let Some(n) = modes.iter().position(|m| !m.is_proportional()) {
+                return Err(DynamicsError::invalid(
+                    format!("modes[{n}].residue_phase_deg"),
+                    "process damping adds to the damping of real modes; it is not defined for \
+                     non-proportional (complex) modes: drop residue_phase_deg or process_damping",
+                ));
+            }
             if operation.cutting_diameter_m().is_none() {
                 return Err(DynamicsError::invalid(
                     "process_damping",
@@ -274,6 +380,30 @@ impl ModalModel {
         Self {
             name,
             ..self.clone()
+        }
+    }
+
+    /// Whether every mode is real (proportionally damped).
+    pub fn is_proportional(&self) -> bool {
+        self.modes.iter().all(Mode::is_proportional)
+    }
+
+    /// An error naming `method` when a mode is non-proportional: for the methods built on real
+    /// modal coordinates q'' + 2 Z Omega q' + Omega^2 q = Phi^T f, which cannot represent a
+    /// complex residue.
+    pub fn require_proportional(&self, method: &str) -> Result<()> {
+        match self.modes.iter().position(|m| !m.is_proportional()) {
+            None => Ok(()),
+            Some(n) => Err(DynamicsError::invalid(
+                format!("modes[{n}].residue_phase_deg"),
+                format!(
+                    "{method} models real (proportionally damped) modes only, and mode {n} \
+                     ({} Hz) is non-proportional (residue phase {:.4} deg); use the zero-order \
+                     method (`--method zoa`), which takes complex modes",
+                    crate::limits::written(self.modes[n].frequency_hz()),
+                    self.modes[n].residue_phase_rad().to_degrees()
+                ),
+            )),
         }
     }
 

@@ -154,6 +154,10 @@ pub struct ModeFile {
     /// Mass-normalized shape over coordinate names, 1/sqrt(kg).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<BTreeMap<String, f64>>,
+    /// Residue phase of a non-proportional (complex) mode, degrees in (-180, 180]; absent or 0
+    /// for a real mode ([`crate::model`] module docs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residue_phase_deg: Option<f64>,
 }
 
 /// `process_damping` object.
@@ -308,7 +312,11 @@ impl ModeFile {
                 ));
             }
         };
-        Mode::new(self.frequency_hz, self.damping_ratio, shape).map_err(|e| match e {
+        let mode = Mode::new(self.frequency_hz, self.damping_ratio, shape).and_then(|m| {
+            self.residue_phase_deg
+                .map_or(Ok(m), |a| m.with_residue_phase(a.to_radians()))
+        });
+        mode.map_err(|e| match e {
             DynamicsError::InvalidValue {
                 field: f,
                 value,
@@ -513,6 +521,8 @@ impl ModelFile {
                     stiffness_n_per_m,
                     direction,
                     shape,
+                    residue_phase_deg: (!m.is_proportional())
+                        .then(|| m.residue_phase_rad().to_degrees()),
                 }
             })
             .collect();

@@ -225,6 +225,7 @@ pub fn simulate_with_observer(
     observer: &dyn SimulationObserver,
 ) -> Result<Simulation> {
     settings.validate()?;
+    model.require_proportional("the time-domain simulation")?;
     let model = match (model.operation(), settings.radial_immersion) {
         (Operation::Milling(m), Some(r)) => {
             model.with_operation(Operation::Milling(m.with_radial_immersion(r)?))?

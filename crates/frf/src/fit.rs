@@ -35,6 +35,7 @@
 
 use crate::error::{FrfError, Result};
 use crate::frf::Frf;
+use chatter_dynamics::{Mode, ModeShape};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -49,6 +50,9 @@ const MAX_RESIDUAL_MODES: usize = 8;
 /// Largest damping ratio of a mode added beyond the stabilization diagram's: a wider "mode" is
 /// the refinement fitting a smooth trend, not a resonance.
 const MAX_ADDED_DAMPING: f64 = 0.15;
+/// Share of the real modes' misfit by which the complex modes must fit better for the data to
+/// need them ([`ModalFit::needs_complex_modes`]): the same 5 % that an added mode must gain.
+pub const COMPLEX_MODE_GAIN: f64 = 0.05;
 /// Most clusters tried beyond those that pass `min_share`.
 const MAX_SPARE_TRIALS: usize = 12;
 
@@ -94,7 +98,8 @@ pub enum Residuals {
     UpperAndLower,
 }
 
-/// One fitted mode.
+/// One fitted mode: the fit's report of it. [`Self::complex_mode`] and [`Self::real_mode`] give
+/// it as the model's [`Mode`], which holds the pole-residue conversion (one place).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FittedMode {
     /// Natural frequency (Hz).
@@ -132,10 +137,41 @@ pub struct ModalFit {
     pub lower_residual_per_kg: f64,
     /// Relative L2 misfit of the complex-mode fit with residual terms over the band.
     pub relative_misfit: f64,
-    /// Relative L2 misfit of the real modes alone (what a model file keeps).
+    /// Relative L2 misfit of the real modes alone (what a model file of real modes keeps).
     pub real_mode_relative_misfit: f64,
+    /// Relative L2 misfit of the complex modes alone, without residual terms (what a model
+    /// file of non-proportional modes keeps).
+    pub complex_mode_relative_misfit: f64,
     /// The stabilization diagram.
     pub stabilization: Vec<StabilizationOrder>,
+}
+
+impl FittedMode {
+    /// The complex residue A_r (m/(N s)).
+    pub fn residue(&self) -> Complex64 {
+        Complex64::new(self.residue_m_per_n_s[0], self.residue_m_per_n_s[1])
+    }
+
+    /// The mode as a model's non-proportional mode at `coordinate` (its complex residue kept,
+    /// [`Mode::from_residue`]).
+    pub fn complex_mode(&self, coordinate: usize) -> Result<Mode> {
+        Ok(Mode::from_residue(
+            self.frequency_hz,
+            self.damping_ratio,
+            coordinate,
+            self.residue(),
+        )?)
+    }
+
+    /// The mode as a real (proportional) mode at `coordinate` with the real-mode refit's
+    /// stiffness; None where that refit gives a negative modal mass.
+    pub fn real_mode(&self, coordinate: usize) -> Option<Mode> {
+        let shape = ModeShape::Directional {
+            coordinate,
+            stiffness_n_per_m: self.stiffness_n_per_m?,
+        };
+        Mode::new(self.frequency_hz, self.damping_ratio, shape).ok()
+    }
 }
 
 fn pole(mode: &FittedMode) -> Complex64 {
@@ -155,7 +191,7 @@ impl ModalFit {
         }
         for m in &self.modes {
             let s = pole(m);
-            let a = Complex64::new(m.residue_m_per_n_s[0], m.residue_m_per_n_s[1]);
+            let a = m.residue();
             h += a / (iw - s) + a.conj() / (iw - s.conj());
         }
         h
@@ -163,15 +199,28 @@ impl ModalFit {
 
     /// The real modes alone at `frequency_hz`: sum k_r^-1 w_r^2 / (w_r^2 - w^2 + 2 i zeta_r w_r w).
     pub fn real_mode_receptance(&self, frequency_hz: f64) -> Complex64 {
-        let w = 2.0 * PI * frequency_hz;
         self.modes
             .iter()
-            .filter_map(|m| {
-                let k = m.stiffness_n_per_m?;
-                let wn = 2.0 * PI * m.frequency_hz;
-                Some(wn * wn / k / Complex64::new(wn * wn - w * w, 2.0 * m.damping_ratio * wn * w))
-            })
+            .filter_map(|m| m.real_mode(0))
+            .map(|m| m.receptance(frequency_hz, 0, 0))
             .sum()
+    }
+
+    /// The complex modes alone, without residual terms, at `frequency_hz`: what a model file
+    /// with non-proportional modes keeps.
+    pub fn complex_mode_receptance(&self, frequency_hz: f64) -> Complex64 {
+        self.modes
+            .iter()
+            .filter_map(|m| m.complex_mode(0).ok())
+            .map(|m| m.receptance(frequency_hz, 0, 0))
+            .sum()
+    }
+
+    /// Whether the data need non-proportional modes: the complex modes alone fit the band
+    /// better than the real modes by more than [`COMPLEX_MODE_GAIN`] of the real modes' misfit.
+    pub fn needs_complex_modes(&self) -> bool {
+        self.complex_mode_relative_misfit
+            < (1.0 - COMPLEX_MODE_GAIN) * self.real_mode_relative_misfit
     }
 }
 
@@ -692,6 +741,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         lower_residual_per_kg: lower,
         relative_misfit: f64::NAN,
         real_mode_relative_misfit: f64::NAN,
+        complex_mode_relative_misfit: f64::NAN,
         stabilization,
     };
     out.relative_misfit = band
@@ -699,6 +749,9 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         .unwrap_or(f64::NAN);
     out.real_mode_relative_misfit = band
         .relative_misfit(|f| Some(out.real_mode_receptance(f)), fmin_hz, fmax_hz)
+        .unwrap_or(f64::NAN);
+    out.complex_mode_relative_misfit = band
+        .relative_misfit(|f| Some(out.complex_mode_receptance(f)), fmin_hz, fmax_hz)
         .unwrap_or(f64::NAN);
     Ok(out)
 }

@@ -76,6 +76,7 @@ impl Characteristic {
                 reason: "the characteristic equation with constant K_c is for turning".into(),
             });
         }
+        model.require_proportional("the frequency-domain method")?;
         let phi = model.shape_matrix();
         let h = model.directional_matrix(0.0, speed_rpm);
         let hm = DMatrix::from_fn(2, 2, |i, j| h[(i, j)]);

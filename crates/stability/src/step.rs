@@ -252,6 +252,7 @@ impl StepPlan {
     /// The plan of `method` for `model` at `speed_rpm`.
     pub fn new(model: &ModalModel, speed_rpm: f64, method: Discretization) -> Result<Self> {
         check_condition(speed_rpm, 0.0)?;
+        model.require_proportional(method.scheme.name())?;
         let n = model.mode_count();
         let d = 2 * n;
         let tau = model.operation().delay_s(speed_rpm);

@@ -301,6 +301,9 @@ impl TurningPoleLikelihood {
                 "the characteristic-equation likelihood is for turning models".into(),
             ));
         }
+        parameterization
+            .nominal()
+            .require_proportional("the characteristic-equation likelihood")?;
         if poles.is_empty() {
             return Err(UpdatingError::Observations("no identified poles".into()));
         }

@@ -93,6 +93,13 @@ pub fn model_table(label: &str, m: &ModalModel) -> Table {
                 "1/sqrt(kg)",
             ),
         }
+        if !mode.is_proportional() {
+            row(
+                &format!("mode {n} residue phase (non-proportional)"),
+                number(mode.residue_phase_rad().to_degrees()),
+                "deg",
+            );
+        }
     }
     t
 }

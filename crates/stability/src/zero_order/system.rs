@@ -4,7 +4,8 @@
 //!
 //! G(i w) = sum_n phi_n phi_n^T / (w_n^2 - w^2 + 2 i zeta_n w_n w),
 //!
-//! over mass-normalized mode shapes phi_n. Process damping (003 Section 2) enters as the
+//! over mass-normalized mode shapes phi_n; a non-proportional (complex) mode multiplies its term
+//! by n_0 + n_1 i w ([`chatter_dynamics::model::complex_mode_numerator`]). Process damping (003 Section 2) enters as the
 //! equivalent damping ratios zeta_n + b s_n of [`crate::process_damping::with_equivalent_damping`],
 //! with s_n = d zeta_n / d b from [`crate::process_damping::damping_ratio_slope_per_m`].
 //!
@@ -30,6 +31,9 @@ pub struct ModalTerm {
     pub damping_ratio: f64,
     /// Mass-normalized shape phi_n over the two coordinates (1/sqrt(kg)).
     pub shape: [f64; 2],
+    /// Receptance numerator (n_0, n_1 in s) of a non-proportional mode
+    /// ([`chatter_dynamics::model::complex_mode_numerator`]); (1, 0) for a real mode.
+    pub numerator: (f64, f64),
 }
 
 /// The structure and the averaged cutting forces of a zero-order problem.
@@ -121,10 +125,21 @@ impl ModalTerm {
         if !(self.damping_ratio.is_finite() && self.damping_ratio >= 0.0) {
             return invalid("damping_ratio", self.damping_ratio, "a damping ratio >= 0");
         }
-        match self.shape.iter().find(|v| !v.is_finite()) {
-            Some(&v) => invalid("shape", v, "a finite mode shape"),
-            None => Ok(()),
+        if let Some(&v) = self.shape.iter().find(|v| !v.is_finite()) {
+            return invalid("shape", v, "a finite mode shape");
         }
+        let (n0, n1) = self.numerator;
+        if !(n0.is_finite() && n1.is_finite()) {
+            return invalid("numerator", n0 + n1, "a finite receptance numerator");
+        }
+        if self.numerator != (1.0, 0.0) && self.damping_ratio == 0.0 {
+            return invalid(
+                "damping_ratio",
+                0.0,
+                "a damping ratio > 0 for a non-proportional mode",
+            );
+        }
+        Ok(())
     }
 }
 
@@ -160,6 +175,7 @@ impl OrientedSystem {
                 omega_rad_s: m.omega_rad_s(),
                 damping_ratio: m.damping_ratio(),
                 shape: m.mass_normalized_shape(),
+                numerator: m.receptance_numerator(),
             })
             .collect();
         Self::new(modes, [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]])
@@ -189,7 +205,9 @@ impl OrientedSystem {
         for (n, m) in self.modes.iter().enumerate() {
             let zeta = added.damping_ratio(n, m)?;
             let wn = m.omega_rad_s;
-            let inv = Complex64::new(wn * wn - w * w, 2.0 * zeta * wn * w).inv();
+            let (n0, n1) = m.numerator;
+            let inv =
+                Complex64::new(n0, n1 * w) / Complex64::new(wn * wn - w * w, 2.0 * zeta * wn * w);
             let [p, q] = m.shape;
             g[0] += inv * (p * p);
             g[1] += inv * (p * q);
@@ -358,6 +376,7 @@ mod tests {
             omega_rad_s: 1000.0,
             damping_ratio: 0.02,
             shape: [1.0, 0.0],
+            numerator: (1.0, 0.0),
         };
         let a = [[1e9, 0.0], [0.0, 0.0]];
         assert!(OrientedSystem::new(vec![good], a).is_ok());
@@ -373,6 +392,11 @@ mod tests {
             },
             ModalTerm {
                 shape: [f64::INFINITY, 0.0],
+                ..good
+            },
+            ModalTerm {
+                numerator: (0.9, 1e-5),
+                damping_ratio: 0.0,
                 ..good
             },
         ] {

@@ -277,3 +277,74 @@ fn ceilings_and_bad_inputs() {
         table.lobes(0.1, 2).unwrap()
     );
 }
+
+/// Non-proportional modes: the zero-order table of a model with complex residues against the
+/// measured-FRF route on its receptance sampled at 0.05 Hz (a different solver: interpolation
+/// and bisection on samples, no modal grid); the methods built on real modal coordinates refuse
+/// the model and name themselves.
+#[test]
+fn complex_modes_in_the_table_agree_with_their_sampled_receptance() {
+    use crate::{Method, StabilitySolver, boundary::BoundaryOptions};
+    let base = examples::schmitz_2023_milling();
+    let modes: Vec<Mode> = base
+        .modes()
+        .iter()
+        .zip([0.45, -0.3, 0.2, 0.1])
+        .map(|(m, a)| m.with_residue_phase(a).unwrap())
+        .collect();
+    let model = base.with_modes(modes).unwrap();
+    let speeds: Vec<f64> = (0..40).map(|i| 5000.0 + 250.0 * i as f64).collect();
+    let table = zoa_lobes(&model, &speeds).unwrap();
+    let f_max = base
+        .modes()
+        .iter()
+        .map(|m| m.frequency_hz())
+        .fold(0.0, f64::max);
+    let (lo, hi) = (0.25 * f_max, 2.0 * f_max);
+    let grid: Vec<f64> = (0..((hi - lo) / 0.05) as usize)
+        .map(|k| lo + 0.05 * k as f64)
+        .collect();
+    let sampled = measured_limiting_depths(
+        model.operation(),
+        model.cutting(),
+        &model.sampled_receptance(grid).unwrap(),
+        &speeds,
+        &ZeroOrderOptions::unbounded(),
+    )
+    .unwrap();
+    let worst = table
+        .iter()
+        .zip(&sampled)
+        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-4, "{worst}");
+    // the phases matter: the real-mode lobes differ
+    let real = zoa_lobes(&base, &speeds).unwrap();
+    let moved = table
+        .iter()
+        .zip(&real)
+        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
+        .fold(0.0, f64::max);
+    eprintln!("complex modes: table vs sampled {worst:.2e}, moved from the real modes {moved:.3}");
+    assert!(moved > 0.05, "{moved}");
+    let options = BoundaryOptions::default();
+    for method in [Method::Fdm, Method::Sdm] {
+        let e = Method::prepare(method, &model, &options)
+            .and_then(|s| s.dominant_multiplier(8000.0, 1e-4))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(method.name()) && e.contains("residue_phase_deg"),
+            "{e}"
+        );
+    }
+    let turning = examples::ahmadi_2022_turning();
+    let complex_turning = turning
+        .with_modes(vec![turning.modes()[0].with_residue_phase(0.2).unwrap()])
+        .unwrap();
+    let e = crate::frequency_domain::FrequencyDomain
+        .dominant_multiplier(&complex_turning, 7000.0, 1e-4)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("frequency-domain"), "{e}");
+}
