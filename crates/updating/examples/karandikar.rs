@@ -90,7 +90,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.reduction_percent, mark(ok)
         );
     }
-    if arg("--table-only").is_some() || std::env::args().any(|a| a == "--table-only") {
+    // why D's reduction is small here: how much C moves the limit at each candidate speed
+    println!("\nlimiting depth (mm) at the nominal kt, kn against C (0.5e5, 2.5e5, 5e5, 7.5e5, 10e5 N/m):");
+    let options = chatter_updating::boundary::BoundaryOptions {
+        max_depth_m: karandikar::MAX_DEPTH_M,
+        ..Default::default()
+    };
+    for speed in speeds {
+        let limits = [0.5e5, 2.5e5, 5e5, 7.5e5, 10e5]
+            .iter()
+            .map(|&c| {
+                let m = model.with_process_damping(Some(c))?;
+                let p = chatter_updating::boundary::limiting_depth(&m, speed, &options)?;
+                Ok(format!("{:5.2}", p.depth_m.min(karandikar::MAX_DEPTH_M) * 1e3))
+            })
+            .collect::<Result<Vec<_>, chatter_updating::UpdatingError>>()?;
+        println!("  {speed:5.0} rpm: {}", limits.join(" "));
+    }
+    if std::env::args().any(|a| a == "--table-only") {
         return Ok(());
     }
 
