@@ -66,19 +66,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?;
         model = model.with_modes(vec![m])?;
     }
-    println!("seed 003 flexure: 228 Hz, k {k:.4e} N/m, zeta {zeta}; {paths} prior paths, seed {seed}");
+    println!(
+        "seed 003 flexure: 228 Hz, k {k:.4e} N/m, zeta {zeta}; {paths} prior paths, seed {seed}"
+    );
 
     let speeds = [400.0, 1000.0, 1500.0, 2000.0];
     let prior = karandikar::prior_paths(&model, paths, &speeds, seed, &Silent)?;
     let (_, sd0) = prior.moments(2)?;
-    println!("prior sigma_C: ours {sd0:.3e} N/m, paper {PAPER_PRIOR_SD_C:.3e} (U(0.5e5, 10e5): 2.742e5)");
+    println!(
+        "prior sigma_C: ours {sd0:.3e} N/m, paper {PAPER_PRIOR_SD_C:.3e} (U(0.5e5, 10e5): 2.742e5)"
+    );
     println!("\nprior P_s in the text (Figs. 7-8), tolerance {P_TOLERANCE}:");
     for (speed, depth, paper) in PAPER_PRIOR_P_STABLE {
         let ours = prior.probability_of_stability(speed, depth * 1e-3)?;
         let ok = (ours - paper).abs() <= P_TOLERANCE;
-        println!("  {speed:5.0} rpm {depth:4.2} mm: paper {paper:4.2}  ours {ours:5.3}  {}", mark(ok));
+        println!(
+            "  {speed:5.0} rpm {depth:4.2} mm: paper {paper:4.2}  ours {ours:5.3}  {}",
+            mark(ok)
+        );
     }
-    println!("\nTable 2 (expected % reduction of sigma_C), tolerances {P_TOLERANCE} and {REDUCTION_TOLERANCE} points:");
+    println!(
+        "\nTable 2 (expected % reduction of sigma_C), tolerances {P_TOLERANCE} and {REDUCTION_TOLERANCE} points:"
+    );
     println!("  test  rpm    mm    P_s paper/ours     reduction paper/ours");
     for r in karandikar::table_2(&prior)? {
         let t = r.test;
@@ -86,12 +95,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             && (r.reduction_percent - t.paper_reduction_percent).abs() <= REDUCTION_TOLERANCE;
         println!(
             "  {}  {:6.0} {:5.2}    {:4.2} / {:5.3}      {:5.1} / {:5.1}   {}",
-            t.label, t.speed_rpm, t.depth_mm, t.paper_p_stable, r.p_stable, t.paper_reduction_percent,
-            r.reduction_percent, mark(ok)
+            t.label,
+            t.speed_rpm,
+            t.depth_mm,
+            t.paper_p_stable,
+            r.p_stable,
+            t.paper_reduction_percent,
+            r.reduction_percent,
+            mark(ok)
         );
     }
     // why D's reduction is small here: how much C moves the limit at each candidate speed
-    println!("\nlimiting depth (mm) at the nominal kt, kn against C (0.5e5, 2.5e5, 5e5, 7.5e5, 10e5 N/m):");
+    println!(
+        "\nlimiting depth (mm) at the nominal kt, kn against C (0.5e5, 2.5e5, 5e5, 7.5e5, 10e5 N/m):"
+    );
     let options = chatter_updating::boundary::BoundaryOptions {
         max_depth_m: karandikar::MAX_DEPTH_M,
         ..Default::default()
@@ -102,7 +119,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map(|&c| {
                 let m = model.with_process_damping(Some(c))?;
                 let p = chatter_updating::boundary::limiting_depth(&m, speed, &options)?;
-                Ok(format!("{:5.2}", p.depth_m.min(karandikar::MAX_DEPTH_M) * 1e3))
+                Ok(format!(
+                    "{:5.2}",
+                    p.depth_m.min(karandikar::MAX_DEPTH_M) * 1e3
+                ))
             })
             .collect::<Result<Vec<_>, chatter_updating::UpdatingError>>()?;
         println!("  {speed:5.0} rpm: {}", limits.join(" "));
@@ -123,7 +143,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             max_depth_m: 0.1,
             ..Default::default()
         };
-        let limit = boundary::limiting_depth(&Discretization::full().with_steps(steps), &truth, speed, &options)?;
+        let limit = boundary::limiting_depth(
+            &Discretization::full().with_steps(steps),
+            &truth,
+            speed,
+            &options,
+        )?;
         for i in 1..=8 {
             let depth_mm = 0.5 * i as f64;
             cuts.push(Cut {
