@@ -264,6 +264,7 @@ struct LobeMap {
 }
 
 /// `chatter lobes`.
+#[allow(clippy::too_many_arguments)]
 pub fn lobes(
     model_path: &Path,
     method: Method,

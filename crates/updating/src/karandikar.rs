@@ -6,7 +6,7 @@
 //! kn) is `examples/karandikar_flexure_model.json`. The text gives neither the flexure's stiffness
 //! nor its damping ratio; they were calibrated so that the prior paths reproduce the prior
 //! probabilities of stability the paper reports (Sec. "Establishing the prior", Table 2; the scan
-//! is `examples/karandikar.rs --calibrate`).
+//! is `examples/karandikar.rs` with `--stiffness-n-per-m` and `--damping-ratio`).
 //!
 //! RSS (Sec. "Process damping coefficient identification", after Tyler and Schmitz 2012): per
 //! speed the experimental limit b_exp is the midpoint between the deepest stable cut below the
@@ -207,7 +207,7 @@ pub struct RssFit {
 }
 
 /// Single-variable RSS identification of C (003, Tyler and Schmitz 2012) over
-/// [`c_low`, `c_high`] N/m: a scan of 40 values, then golden-section refinement to 0.1 % of the
+/// `c_low`..`c_high` N/m: a scan of 40 values, then golden-section refinement to 0.1 % of the
 /// range. Errors without an experimental limit (no unstable cut).
 pub fn rss_process_damping(
     model: &ModalModel,
