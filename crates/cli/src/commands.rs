@@ -181,27 +181,90 @@ pub fn warn_unbounded(lobes: &[LobePoint], fate: &str) {
     }
 }
 
-/// Read the model and observations, pick the speeds and compute the limiting depths.
+/// Options of `chatter lobes` beyond the lobe CSV and plot ([`crate::lobe_map`]).
+pub struct LobeExtras<'a> {
+    /// Fixed fdm/sdm cutting steps per delay.
+    pub cutting_steps: Option<usize>,
+    /// |mu| map CSV.
+    pub map_out: Option<&'a Path>,
+    /// |mu| heat map SVG.
+    pub map_plot: Option<&'a Path>,
+    /// Map depths MIN:MAX:N (mm).
+    pub depths: Option<&'a str>,
+}
+
+/// Read the model and observations, pick the speeds and compute the limiting depths; with a
+/// map requested, also the |mu| map (speeds, depths in m, rows per speed).
 fn load_and_compute(
     model_path: &Path,
     method: Method,
     speeds: Option<&str>,
     observations: Option<&Path>,
+    extras: &LobeExtras,
     quiet: bool,
-) -> Result<(Option<Observations>, Vec<LobePoint>)> {
+) -> Result<(Option<Observations>, Vec<LobePoint>, Option<LobeMap>)> {
     let obs = observations.map(inputs::observations).transpose()?;
+    let wants_map = extras.map_out.is_some() || extras.map_plot.is_some();
+    validate::unused(
+        !wants_map && extras.depths.is_some(),
+        "--depths",
+        "without --map-out or --map-plot",
+        "the |mu| map",
+    )?;
+    let direct = extras.cutting_steps.is_none() && !wants_map;
     if let Some(lobes) = crate::measured::lobes(model_path, method, speeds)? {
-        return Ok((obs, lobes));
+        if !direct {
+            bail!(
+                "--cutting-steps, --map-out and --map-plot need a modal model (run chatter fit-frf)"
+            );
+        }
+        return Ok((obs, lobes, None));
     }
     let model = inputs::model(model_path)?;
     let speeds = match speeds {
         Some(s) => validate::speeds(s)?,
-        None => chatter_stability::boundary::default_speeds_rpm(&model),
+        None => chatter_stability::speed_grid::lobe_speeds_rpm(&model),
     };
-    Ok((obs, compute_lobes(&model, method, &speeds, quiet)?))
+    if direct {
+        return Ok((obs, compute_lobes(&model, method, &speeds, quiet)?, None));
+    }
+    if let Some(d) = method.discretization() {
+        let d = extras.cutting_steps.map_or(d, |m| d.with_steps(m));
+        validate::work_size(&model, d, &speeds, "--speeds")?;
+    }
+    let solver = crate::lobe_map::solver(&model, method, extras.cutting_steps)?;
+    let bar = Bar::new(speeds.len() as u64, "lobes", quiet);
+    let lobes = solver.lobes(&speeds, &bar)?;
+    bar.finish();
+    let map = if wants_map {
+        let depths_m = match extras.depths {
+            Some(s) => validate::grid("--depths", s, &validate::DEPTH_GRID_MM)?
+                .into_iter()
+                .map(|mm| mm * 1e-3)
+                .collect(),
+            None => crate::lobe_map::default_depths_m(&lobes)?,
+        };
+        let grid = crate::lobe_map::modulus_map(solver.as_ref(), &speeds, &depths_m, quiet)?;
+        Some(LobeMap {
+            speeds_rpm: speeds,
+            depths_m,
+            grid,
+        })
+    } else {
+        None
+    };
+    Ok((obs, lobes, map))
+}
+
+/// A |mu| map of `chatter lobes`.
+struct LobeMap {
+    speeds_rpm: Vec<f64>,
+    depths_m: Vec<f64>,
+    grid: Vec<Vec<f64>>,
 }
 
 /// `chatter lobes`.
+#[allow(clippy::too_many_arguments)]
 pub fn lobes(
     model_path: &Path,
     method: Method,
@@ -209,11 +272,32 @@ pub fn lobes(
     observations: Option<&Path>,
     out: Option<&Path>,
     plot: Option<&Path>,
+    extras: &LobeExtras,
     quiet: bool,
 ) -> Result<()> {
     check_outputs(out, plot, observations)?;
-    let (obs, lobes) = load_and_compute(model_path, method, speeds, observations, quiet)?;
+    output::check_optional_file("--map-out", extras.map_out)?;
+    output::check_optional_file("--map-plot", extras.map_plot)?;
+    let (obs, lobes, map) =
+        load_and_compute(model_path, method, speeds, observations, extras, quiet)?;
     warn_unbounded(&lobes, "their depth_mm and chatter_hz cells are empty");
+    if let Some(m) = &map {
+        if let Some(p) = extras.map_out {
+            write_atomic(
+                p,
+                crate::lobe_map::csv(&m.speeds_rpm, &m.depths_m, &m.grid).as_bytes(),
+            )?;
+        }
+        if let Some(p) = extras.map_plot {
+            let title = format!(
+                "Dominant multiplier |mu| ({}): blue stable, red chatter, black the limit",
+                method.name()
+            );
+            let svg =
+                crate::lobe_map::heat_map_svg(&title, &m.speeds_rpm, &m.depths_m, &m.grid, &lobes)?;
+            write_atomic(p, svg.as_bytes())?;
+        }
+    }
     emit(out, &lobes_csv(&lobes))?;
     if let Some(p) = plot {
         let series = [Series {
@@ -228,7 +312,10 @@ pub fn lobes(
         }];
         line_chart(
             p,
-            "Stability lobes",
+            &format!(
+                "Stability lobes ({}): limiting depth against spindle speed",
+                method.name()
+            ),
             "spindle speed (rpm)",
             "depth (mm)",
             &series,
@@ -298,7 +385,8 @@ pub fn multiplier(
 }
 
 /// What `--out` of `chatter demo` may hold (the folder of its previous run).
-pub const DEMO_FILES: [&str; 12] = [
+pub const DEMO_FILES: [&str; 13] = [
+    "papers.csv",
     "turning_lobes.csv",
     "turning_lobes.svg",
     "eq34_covariance.json",
@@ -321,7 +409,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     let mut summary = serde_json::Map::new();
     let stage = |k: usize, what: &str| {
         if !quiet {
-            eprintln!("demo {k}/4: {what}");
+            eprintln!("demo {k}/5: {what}");
         }
     };
 
@@ -421,9 +509,25 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     }
     folder.add("milling_frf.csv", frf_csv(&milling, 0.0, 1500.0, 301, 0, 0));
 
-    // 4. Sim-to-real gap: a synthetic shop-floor campaign of a milling machine whose process
+    // 4. The seeds' published numbers beside ours, with tolerances.
+    stage(
+        4,
+        "the papers' numbers beside ours (000 Table 3, 001 lobe extremes, 003 Table 2)",
+    );
+    let rows = crate::papers::rows(&zoa)?;
+    folder.add("papers.csv", crate::papers::csv(&rows));
+    summary.insert(
+        "papers".into(),
+        serde_json::json!({
+            "rows": rows.len(),
+            "within_tolerance": rows.iter().filter(|r| r.within()).count(),
+            "outside": rows.iter().filter(|r| !r.within()).map(|r| format!("{}: {}", r.source, r.quantity)).collect::<Vec<_>>(),
+        }),
+    );
+
+    // 5. Sim-to-real gap: a synthetic shop-floor campaign of a milling machine whose process
     //    damping the nominal model leaves out, diagnosed from the nominal model and the data.
-    stage(4, "sim-to-real gap diagnosis of a synthetic campaign");
+    stage(5, "sim-to-real gap diagnosis of a synthetic campaign");
     let nominal = chatter_gap::nominal_milling()?;
     let mut scenario = chatter_gap::Scenario::new(chatter_gap::HiddenEffect::ParameterError, 101);
     (scenario.effect, _) = chatter_gap::generator::effect_at(

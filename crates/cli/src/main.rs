@@ -9,10 +9,12 @@ mod commands;
 mod detect;
 mod diagnose;
 mod inputs;
+mod lobe_map;
 mod measured;
 mod measured_bands;
 mod oma;
 mod output;
+mod papers;
 mod plan;
 mod plot;
 mod progress;
@@ -87,7 +89,8 @@ enum Command {
         /// Stability method.
         #[arg(long, value_enum, default_value = "fdm")]
         method: Method,
-        /// Speeds MIN:MAX:N (rpm); default around the dominant mode's lobes.
+        /// Speeds MIN:MAX:N (rpm); default lobe numbers ~1 to 12 of the dominant mode, evenly
+        /// spaced in lobe number (20 speeds per lobe, 200-2000 speeds) so no lobe is aliased.
         #[arg(long)]
         speeds: Option<String>,
         /// Observed cuts to draw (o stable, x chatter).
@@ -99,6 +102,20 @@ enum Command {
         /// SVG lobe plot.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Resolution of fdm/sdm: steps over the cutting part of one delay (tooth period in
+        /// milling, revolution in turning); default automatic (>= 40, 24 per vibration cycle).
+        #[arg(long)]
+        cutting_steps: Option<usize>,
+        /// Map of the dominant multiplier's modulus |mu| over speed x depth: CSV
+        /// speed_rpm,depth_mm,modulus (|mu| < 1 stable).
+        #[arg(long)]
+        map_out: Option<PathBuf>,
+        /// SVG heat map of |mu| (blue stable, red chatter) with the lobes.
+        #[arg(long)]
+        map_plot: Option<PathBuf>,
+        /// Depths of the |mu| map MIN:MAX:N (mm); default 80 depths up to 1.5x the deepest limit.
+        #[arg(long)]
+        depths: Option<String>,
     },
     /// Dominant Floquet multiplier at one cut, as JSON.
     Multiplier {
@@ -338,6 +355,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             observations,
             out,
             plot,
+            cutting_steps,
+            map_out,
+            map_plot,
+            depths,
         } => commands::lobes(
             &model,
             method,
@@ -345,6 +366,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             observations.as_deref(),
             out.as_deref(),
             plot.as_deref(),
+            &commands::LobeExtras {
+                cutting_steps,
+                map_out: map_out.as_deref(),
+                map_plot: map_plot.as_deref(),
+                depths: depths.as_deref(),
+            },
             quiet,
         ),
         Command::Multiplier {

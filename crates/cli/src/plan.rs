@@ -25,9 +25,10 @@ pub struct PlanArgs {
     /// Model file (JSON).
     #[arg(long)]
     model: PathBuf,
-    /// Cuts made so far (JSON or cuts CSV).
+    /// Cuts made so far (JSON or cuts CSV); without it the first cut is planned from the prior
+    /// on a grid from the model.
     #[arg(long)]
-    observations: PathBuf,
+    observations: Option<PathBuf>,
     /// voi (003) or mrr (004).
     #[arg(long, value_enum)]
     strategy: StrategyArg,
@@ -60,6 +61,13 @@ pub struct PlanArgs {
     /// Seed of the prior samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Width of the cut likelihood in depth (mm): sigma of 003 (voi, default 0.5) or s_S of 004
+    /// (mrr, default 0.125).
+    #[arg(long)]
+    sigma_depth_mm: Option<f64>,
+    /// s_fc of 004 (Hz): allowed chatter-frequency disagreement (mrr only; default 50).
+    #[arg(long)]
+    sigma_chatter_hz: Option<f64>,
     /// Cap on test cuts: `stop` is true once this many cuts were made.
     #[arg(long, default_value_t = chatter_updating::plan::DEFAULT_MAX_TESTS)]
     max_tests: usize,
@@ -93,6 +101,18 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         "with --strategy mrr",
         "--strategy voi",
     )?;
+    validate::unused(
+        voi && args.sigma_chatter_hz.is_some(),
+        "--sigma-chatter-hz",
+        "with --strategy voi",
+        "--strategy mrr (003's likelihood has no frequency term)",
+    )?;
+    if let Some(mm) = args.sigma_depth_mm {
+        validate::option("--sigma-depth-mm", mm, &validate::SIGMA_DEPTH_MM)?;
+    }
+    if let Some(hz) = args.sigma_chatter_hz {
+        validate::option("--sigma-chatter-hz", hz, &validate::SIGMA_CHATTER_HZ)?;
+    }
     if let Some(p) = args.p_test {
         validate::option("--p-test", p, &validate::PROBABILITY)?;
     }
@@ -109,9 +129,15 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         .map(|s| validate::grid("--depths", s, &validate::DEPTH_GRID_MM))
         .transpose()?;
     let model = crate::inputs::model(&args.model)?;
-    let observations = crate::inputs::observations(&args.observations)?;
-    validate::observations_match(&model, &observations, &args.observations, &args.model)?;
-    validate::observation_work_size(&model, &observations, &args.observations)?;
+    let observations = match &args.observations {
+        Some(path) => {
+            let observations = crate::inputs::observations(path)?;
+            validate::observations_match(&model, &observations, path, &args.model)?;
+            validate::observation_work_size(&model, &observations, path)?;
+            observations
+        }
+        None => chatter_dynamics::Observations::default(),
+    };
     if let Some(s) = &speeds {
         validate::work_size(
             &model,
@@ -148,6 +174,8 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         feed_per_tooth_mm: args.feed_per_tooth_mm,
         seed: args.seed,
         max_tests: args.max_tests,
+        sigma_depth_mm: args.sigma_depth_mm,
+        sigma_chatter_hz: args.sigma_chatter_hz,
     };
     let progress = PathProgress(Bar::new(args.paths as u64, "sampled boundaries", quiet));
     let outcome = chatter_jobs::plan::plan(&model, &observations, &request, &progress)

@@ -79,6 +79,10 @@ pub const FEED_MM: Plausible = open_closed(0.0, 10.0, "a feed", "mm");
 pub const FORCE_N: Plausible = closed(0.0, 1e6, "a force", "N");
 /// Frequencies of `chatter frf` (zero allowed).
 pub const FRF_HZ: Plausible = closed(0.0, 1e6, "a frequency", "Hz");
+/// Width in depth of a cut likelihood (003's sigma, 004's s_S).
+pub const SIGMA_DEPTH_MM: Plausible = open_closed(0.0, 100.0, "a likelihood width", "mm");
+/// Chatter-frequency width of a cut likelihood (004's s_fc).
+pub const SIGMA_CHATTER_HZ: Plausible = open_closed(0.0, 1e5, "a likelihood width", "Hz");
 /// Speed offset of the Type B bands.
 pub const OFFSET_RPM: Plausible = closed(0.0, 1e5, "a speed offset", "rpm");
 /// Depth offset of the Type B bands.

@@ -177,6 +177,7 @@ fn demo_writes_its_folder() {
     let dir = tempfile::tempdir().unwrap();
     succeed(chatter().args(["demo", "--quiet", "--out"]).arg(dir.path()));
     for f in [
+        "papers.csv",
         "turning_lobes.csv",
         "turning_lobes.svg",
         "milling_bands.svg",
@@ -218,6 +219,9 @@ fn demo_writes_its_folder() {
             .unwrap();
     assert_eq!(summary["turning_limits"].as_array().unwrap().len(), 4);
     assert_eq!(summary["diagnosis"]["verdict"], "process_damping");
+    // 000 Table 3 (15), 001 lobe extremes (3), 003 Table 2 (8); only D's reduction is outside
+    assert_eq!(summary["papers"]["rows"], 26);
+    assert_eq!(summary["papers"]["within_tolerance"], 25);
 }
 
 #[test]

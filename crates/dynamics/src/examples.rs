@@ -19,6 +19,13 @@ pub const SCHMITZ_2023_MILLING_MODEL: &str =
 /// Model file of the experimental milling case of Ebrahimi-Tirtashi and Ahmadi (2025), seed 002.
 pub const EBRAHIMI_2025_MILLING_MODEL: &str =
     include_str!("../../../examples/ebrahimi2025_milling_model.json");
+/// Model file of the flexure of Karandikar, Tyler and Schmitz (seed 003), stiffness and damping
+/// calibrated to the paper's prior probabilities of stability.
+pub const KARANDIKAR_FLEXURE_MODEL: &str =
+    include_str!("../../../examples/karandikar_flexure_model.json");
+/// Observations of seed 003: the cuts its text reports.
+pub const KARANDIKAR_FLEXURE_OBSERVATIONS: &str =
+    include_str!("../../../examples/karandikar_flexure_observations.json");
 /// Observations of seed 002: Table 2 poles and their stable cuts.
 pub const EBRAHIMI_2025_MILLING_OBSERVATIONS: &str =
     include_str!("../../../examples/ebrahimi2025_milling_observations.json");
@@ -61,6 +68,18 @@ pub fn ebrahimi_2025_milling_observations() -> Observations {
     embedded_observations(
         EBRAHIMI_2025_MILLING_OBSERVATIONS,
         "ebrahimi2025_milling_observations.json",
+    )
+}
+
+/// The flexure of seed 003 (228 Hz, single-tooth 18.54 mm endmill, 50 % up milling, C 2.5e5 N/m).
+pub fn karandikar_flexure() -> ModalModel {
+    embedded_model(KARANDIKAR_FLEXURE_MODEL, "karandikar_flexure_model.json")
+}
+/// Observations of seed 003 (the cuts named in its text).
+pub fn karandikar_flexure_observations() -> Observations {
+    embedded_observations(
+        KARANDIKAR_FLEXURE_OBSERVATIONS,
+        "karandikar_flexure_observations.json",
     )
 }
 

@@ -3,6 +3,7 @@
 
 use crate::error::{JobError, Result, count};
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_updating::cuts::CutKernel;
 use chatter_updating::ensemble::EnsembleObserver;
 use chatter_updating::parameters::ModelParameter;
 use chatter_updating::plan::{PlanOutcome, PlanSettings, Strategy, plan_next_cut};
@@ -33,6 +34,11 @@ pub struct PlanRequest {
     pub seed: u64,
     /// Cap on test cuts.
     pub max_tests: usize,
+    /// Width of the cut likelihood in depth (mm): 003's sigma or 004's s_S; default the
+    /// strategy's paper (0.5 mm for voi, 0.125 mm for mrr).
+    pub sigma_depth_mm: Option<f64>,
+    /// 004's s_fc (Hz), the allowed chatter-frequency disagreement (mrr only); default 50 Hz.
+    pub sigma_chatter_hz: Option<f64>,
 }
 
 impl PlanRequest {
@@ -51,6 +57,8 @@ impl PlanRequest {
             feed_per_tooth_mm: d.feed_per_tooth_m * 1e3,
             seed: d.seed,
             max_tests: d.max_tests,
+            sigma_depth_mm: None,
+            sigma_chatter_hz: None,
         }
     }
 
@@ -64,6 +72,16 @@ impl PlanRequest {
                 expected: "a probability between 0 and 1".into(),
             });
         }
+        let paper = match self.strategy {
+            Strategy::ValueOfInformation => CutKernel::karandikar(),
+            Strategy::MaterialRemovalRate => CutKernel::schmitz(),
+        };
+        let kernel = CutKernel {
+            sigma_depth_m: self
+                .sigma_depth_mm
+                .map_or(paper.sigma_depth_m, |mm| mm * 1e-3),
+            sigma_chatter_hz: self.sigma_chatter_hz.or(paper.sigma_chatter_hz),
+        };
         Ok(PlanSettings {
             strategy: self.strategy,
             p_test: self.p_test,
@@ -79,6 +97,7 @@ impl PlanRequest {
             feed_per_tooth_m: self.feed_per_tooth_mm * 1e-3,
             seed: self.seed,
             max_tests: self.max_tests,
+            kernel: Some(kernel),
         })
     }
 }

@@ -21,6 +21,7 @@ pub mod process_damping;
 pub mod resonance;
 mod root;
 pub mod sensitivity;
+pub mod speed_grid;
 mod step;
 pub mod zero_order;
 

@@ -10,6 +10,7 @@
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
 //! | [`boundary`] | limiting depths of sampled models: full discretization with process damping, prepared per model, on the nominal grid | 000 Eq. 9-11, 003 Eq. 1 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
+//! | [`karandikar`] | 003's prior, Table 2's candidate tests with the paper's numbers, RSS identification of C | 003 |
 //! | [`surrogate`] | Matérn GP surrogate of the dominant milling multiplier, with its error against the exact one | 002 Section 2.2 |
 //! | [`prior_bounds`] | posteriors that pile against a prior bound | 000 Section 6.3 |
 //! | [`defaults`] | the papers' priors, model classes and parameter choice | 000 Section 6, 002 Section 3.2, 003 |
@@ -43,6 +44,7 @@ pub mod cuts;
 pub mod defaults;
 pub mod ensemble;
 pub mod error;
+pub mod karandikar;
 pub mod milling;
 pub mod parameters;
 pub mod plan;

@@ -3,7 +3,7 @@
 //! maximum material removal rate (004: paths drawn from the posterior by rejection sampling and
 //! parallel adaptive MCMC), with the papers' stopping rules.
 
-use crate::boundary::BoundaryOptions;
+use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::cuts::CutKernel;
 use crate::defaults::{default_parameters, parameter_prior};
 use crate::ensemble::{
@@ -56,6 +56,9 @@ pub struct PlanSettings {
     /// Cap on the number of test cuts: the stopping rule fires once this many cuts were made
     /// (default [`DEFAULT_MAX_TESTS`]).
     pub max_tests: usize,
+    /// The cut likelihood's widths (003's sigma, 004's s_S and s_fc); default the strategy's
+    /// paper ([`CutKernel::karandikar`] for value of information, [`CutKernel::schmitz`] for MRR).
+    pub kernel: Option<CutKernel>,
 }
 
 /// Default cap on test cuts of a campaign.
@@ -75,6 +78,7 @@ impl Default for PlanSettings {
             feed_per_tooth_m: 0.1e-3,
             seed: 0,
             max_tests: DEFAULT_MAX_TESTS,
+            kernel: None,
         }
     }
 }
@@ -104,13 +108,41 @@ pub struct PlanOutcome {
     pub effective_samples: f64,
 }
 
-fn grid_default(observations: &Observations) -> Result<(Vec<f64>, Vec<f64>)> {
+/// Candidate speeds and depths when the settings give none. With cuts: the cut speeds +- 25 %
+/// (41 speeds) and 60 depths up to twice the deepest cut. Before the first cut (planning from
+/// the prior): 41 speeds over the model's default lobe range (`chatter-stability`'s
+/// `lobe_speeds_rpm`; with process damping, which acts at low speed, down to a fortieth of
+/// its top instead of a tenth) and 60 depths up to twice the deepest nominal limit there.
+fn grid_default(model: &ModalModel, observations: &Observations) -> Result<(Vec<f64>, Vec<f64>)> {
     let cuts = &observations.cuts;
+    let spread = |lo: f64, hi: f64| -> Vec<f64> {
+        (0..41).map(|i| lo + (hi - lo) * i as f64 / 40.0).collect()
+    };
     if cuts.is_empty() {
-        return Err(UpdatingError::InvalidInput {
-            field: "speeds",
-            message: "no cuts to centre the candidate grid on; give the speeds and depths".into(),
-        });
+        let range = chatter_stability::speed_grid::lobe_speeds_rpm(model);
+        let hi = range.last().copied().unwrap_or(1000.0);
+        let lo = if model.process_damping_n_per_m().is_some() {
+            hi / 40.0
+        } else {
+            range.first().copied().unwrap_or(hi / 10.0)
+        };
+        let speeds = spread(lo, hi);
+        let nominal = limiting_depths(model, model, &speeds, &BoundaryOptions::default())?;
+        let deepest = nominal
+            .iter()
+            .map(|p| p.depth_m)
+            .filter(|d| d.is_finite())
+            .fold(0.0, f64::max);
+        if deepest <= 0.0 {
+            return Err(UpdatingError::InvalidInput {
+                field: "depths",
+                message: "the nominal model is stable at every candidate speed up to the depth \
+                          ceiling; give the speeds and depths"
+                    .into(),
+            });
+        }
+        let depths = (1..=60).map(|i| 2.0 * deepest * i as f64 / 60.0).collect();
+        return Ok((speeds, depths));
     }
     let lo = cuts
         .iter()
@@ -118,10 +150,9 @@ fn grid_default(observations: &Observations) -> Result<(Vec<f64>, Vec<f64>)> {
         .fold(f64::INFINITY, f64::min)
         * 0.75;
     let hi = cuts.iter().map(|c| c.speed_rpm).fold(0.0, f64::max) * 1.25;
-    let speeds = (0..41).map(|i| lo + (hi - lo) * i as f64 / 40.0).collect();
     let deepest = cuts.iter().map(|c| c.depth_mm).fold(0.0, f64::max) * 1e-3;
     let depths = (1..=60).map(|i| 2.0 * deepest * i as f64 / 60.0).collect();
-    Ok((speeds, depths))
+    Ok((spread(lo, hi), depths))
 }
 
 /// Propose the next cut from the model, the cuts made so far and the settings.
@@ -163,7 +194,7 @@ pub fn plan_next_cut(
     let (speeds, depths) = match (&settings.speeds_rpm, &settings.depths_m) {
         (Some(s), Some(d)) => (s.clone(), d.clone()),
         (s, d) => {
-            let (ds, dd) = grid_default(observations)?;
+            let (ds, dd) = grid_default(model, observations)?;
             (s.clone().unwrap_or(ds), d.clone().unwrap_or(dd))
         }
     };
@@ -172,10 +203,13 @@ pub fn plan_next_cut(
         max_depth_m: (2.0 * max_depth).max(1e-3),
         ..Default::default()
     };
-    let kernel = match settings.strategy {
-        Strategy::ValueOfInformation => CutKernel::karandikar(),
-        Strategy::MaterialRemovalRate => CutKernel::schmitz(),
-    };
+    let kernel = settings
+        .kernel
+        .unwrap_or(match settings.strategy {
+            Strategy::ValueOfInformation => CutKernel::karandikar(),
+            Strategy::MaterialRemovalRate => CutKernel::schmitz(),
+        })
+        .validated()?;
     let ensemble = match settings.strategy {
         // 003: fixed prior paths, reweighted by every cut
         Strategy::ValueOfInformation => {
@@ -312,7 +346,14 @@ mod tests {
             assert_eq!(out.cuts_used, 7);
             assert!(out.best_stable_mrr_cm3_per_min.is_some());
         }
+        // before the first cut the grid comes from the model and the paths from the prior
         let empty = Observations::default();
-        assert!(plan_next_cut(&model, &empty, &PlanSettings::default(), &Silent).is_err());
+        let settings = PlanSettings {
+            paths: 30,
+            ..Default::default()
+        };
+        let first = plan_next_cut(&model, &empty, &settings, &Silent).unwrap();
+        assert_eq!(first.cuts_used, 0);
+        assert!(first.next_cut.is_some());
     }
 }
