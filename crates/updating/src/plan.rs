@@ -3,17 +3,16 @@
 //! maximum material removal rate (004: paths drawn from the posterior by rejection sampling and
 //! parallel adaptive MCMC), with the papers' stopping rules.
 
-use crate::boundary::BoundaryOptions;
 use crate::cuts::CutKernel;
 use crate::defaults::{default_parameters, parameter_prior};
-use crate::ensemble::{
-    BoundaryEnsemble, EnsembleObserver, TestPlan, material_removal_rate_cm3_per_min,
-};
+use crate::ensemble::{BoundaryEnsemble, TestPlan, material_removal_rate_cm3_per_min};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::update::PriorOverrides;
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_progress::Observer;
+use chatter_stability::prepared::SolverOptions;
 
 /// How the next test is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -129,7 +128,7 @@ pub fn plan_next_cut(
     model: &ModalModel,
     observations: &Observations,
     settings: &PlanSettings,
-    observer: &dyn EnsembleObserver,
+    observer: &dyn Observer,
 ) -> Result<PlanOutcome> {
     if !(settings.feed_per_tooth_m.is_finite() && settings.feed_per_tooth_m > 0.0) {
         return Err(UpdatingError::InvalidInput {
@@ -168,10 +167,7 @@ pub fn plan_next_cut(
         }
     };
     let max_depth = depths.iter().copied().fold(0.0, f64::max);
-    let options = BoundaryOptions {
-        max_depth_m: (2.0 * max_depth).max(1e-3),
-        ..Default::default()
-    };
+    let options = SolverOptions::default().with_max_depth_m((2.0 * max_depth).max(1e-3));
     let kernel = match settings.strategy {
         Strategy::ValueOfInformation => CutKernel::karandikar(),
         Strategy::MaterialRemovalRate => CutKernel::schmitz(),
@@ -292,8 +288,8 @@ pub fn plan_next_cut(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ensemble::Silent;
     use chatter_dynamics::examples;
+    use chatter_progress::Silent;
 
     #[test]
     fn both_strategies_propose_a_cut_on_the_grid() {
