@@ -6,8 +6,9 @@
 //! resolution (`Method::Fdm`: extrapolated from m and 2m steps); the multiplier of the 003-type
 //! flexure at 300 rpm with process damping (clustered multipliers, operator dimension 276).
 use chatter_dynamics::examples;
+use chatter_progress::Silent;
 use chatter_stability::StabilitySolver;
-use chatter_stability::boundary::{BoundaryOptions, Silent, lobe_diagram, speed_range};
+use chatter_stability::boundary::{BoundaryOptions, lobe_diagram, speed_range};
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::prepared::{Method, PreparedDiscretization, PreparedSolver};
 use chatter_stability::zero_order::{zoa_limiting_depth, zoa_lobes};

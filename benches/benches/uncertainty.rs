@@ -42,7 +42,7 @@ fn bench(c: &mut Criterion) {
                 &thetas,
                 &mc_speeds,
                 &BoundaryOptions::default(),
-                &|_, _| {},
+                &chatter_progress::Silent,
             )
             .map(|s| s.stability_map(&depths))
         })

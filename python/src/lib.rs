@@ -188,7 +188,7 @@ fn lobes<'py>(
     let method = method_of(method)?;
     let speeds = speeds_of(&m, speeds_rpm)?;
     let points = run_detached(py, move || {
-        band_jobs::lobes(&m, method, &speeds, &chatter_stability::boundary::Silent)
+        band_jobs::lobes(&m, method, &speeds, &chatter_progress::Silent)
     })?
     .map_err(value_error)?;
     let d = PyDict::new(py);
@@ -258,13 +258,7 @@ fn bands_geometric<'py>(
     let offsets = chatter_uncertainty::geometric::TypeBOffsets::new(offset_rpm, offset_mm)
         .map_err(value_error)?;
     let g = run_detached(py, move || {
-        band_jobs::geometric(
-            &m,
-            method,
-            &speeds,
-            offsets,
-            &chatter_stability::boundary::Silent,
-        )
+        band_jobs::geometric(&m, method, &speeds, offsets, &chatter_progress::Silent)
     })?
     .map_err(value_error)?;
     let b = &g.bands;
@@ -425,7 +419,15 @@ fn bands_montecarlo<'py>(
         .map(|d| d.as_slice().map(<[f64]>::to_vec))
         .transpose()?;
     let (mc, map) = run_detached(py, move || {
-        let mc = band_jobs::montecarlo(&m, &dist, method, samples, seed, &speeds, &|_, _| {})?;
+        let mc = band_jobs::montecarlo(
+            &m,
+            &dist,
+            method,
+            samples,
+            seed,
+            &speeds,
+            &chatter_progress::Silent,
+        )?;
         let map = mc.map(depths)?;
         Ok::<_, chatter_jobs::JobError>((mc, map))
     })?
@@ -661,7 +663,7 @@ fn update<'py>(
     let prepared =
         chatter_jobs::update::PreparedUpdate::new(&m, &o, request).map_err(value_error)?;
     let (outcome, pointwise) = run_detached(py, move || {
-        let outcome = prepared.run(&chatter_updating::classes::Silent)?;
+        let outcome = prepared.run(&chatter_progress::Silent)?;
         let pointwise = if pointwise {
             let r = &outcome.result;
             Some(
@@ -751,7 +753,7 @@ fn plan<'py>(
     request.seed = seed;
     request.max_tests = max_tests;
     let outcome = run_detached(py, move || {
-        chatter_jobs::plan::plan(&m, &o, &request, &chatter_updating::ensemble::Silent)
+        chatter_jobs::plan::plan(&m, &o, &request, &chatter_progress::Silent)
     })?
     .map_err(value_error)?;
     let mut json = serde_json::to_value(&outcome).map_err(value_error)?;
@@ -797,7 +799,7 @@ fn diagnose<'py>(
         pointwise,
     };
     let diagnosis = run_detached(py, move || {
-        chatter_jobs::diagnose::diagnose(&m, &o, &request, &chatter_gap::diagnose::Quiet)
+        chatter_jobs::diagnose::diagnose(&m, &o, &request, &chatter_progress::Silent)
     })?
     .map_err(value_error)?;
     let out = to_py(py, &diagnosis)?;
@@ -909,7 +911,7 @@ fn batch(
     let options = campaign_options(samples, paths, validation, folds)?;
     let campaigns = campaign::read_manifest(&manifest).map_err(value_error)?;
     run_detached(py, move || {
-        campaign::run_batch(&campaigns, &options, &|_, _| {})
+        campaign::run_batch(&campaigns, &options, &chatter_progress::Silent)
     })
 }
 

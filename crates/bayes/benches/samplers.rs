@@ -5,7 +5,8 @@ use chatter_bayes::amcmc::{AmcmcOptions, adaptive_mcmc};
 use chatter_bayes::gp::{GaussianProcess, GpOptions};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_bayes::rejection::{LikelihoodBound, rejection_sample};
-use chatter_bayes::tmcmc::{Silent, TmcmcOptions, tmcmc};
+use chatter_bayes::tmcmc::{TmcmcOptions, tmcmc};
+use chatter_progress::Silent;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 

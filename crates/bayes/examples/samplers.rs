@@ -11,7 +11,8 @@ use chatter_bayes::gp::{GaussianProcess, GpOptions};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_bayes::rejection::{LikelihoodBound, rejection_sample};
 use chatter_bayes::samples::SampleSet;
-use chatter_bayes::tmcmc::{Silent, TmcmcOptions, tmcmc};
+use chatter_bayes::tmcmc::{TmcmcOptions, tmcmc};
+use chatter_progress::Silent;
 
 const NOISE_SD: f64 = 0.05;
 

@@ -33,7 +33,8 @@
 use crate::error::{BayesError, Result};
 use crate::prior::Prior;
 use crate::samples::SampleSet;
-use crate::tmcmc::{LogLikelihood, SamplerObserver, stream};
+use crate::tmcmc::{LogLikelihood, stream};
+use chatter_progress::Observer;
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -186,7 +187,7 @@ pub fn adaptive_mcmc<P: Prior, L: LogLikelihood>(
     likelihood: &L,
     retained: &[Vec<f64>],
     options: &AmcmcOptions,
-    observer: &dyn SamplerObserver,
+    observer: &dyn Observer,
 ) -> Result<AmcmcResult> {
     let options = options.validated()?;
     let d = prior.dimension();
@@ -257,7 +258,7 @@ struct Sampler<'a, P, L> {
     prior: &'a P,
     likelihood: &'a L,
     options: &'a AmcmcOptions,
-    observer: &'a dyn SamplerObserver,
+    observer: &'a dyn Observer,
 }
 
 impl<P: Prior, L: LogLikelihood> Sampler<'_, P, L> {
@@ -370,7 +371,7 @@ impl<P: Prior, L: LogLikelihood> Sampler<'_, P, L> {
 mod tests {
     use super::*;
     use crate::prior::{IndependentPrior, Marginal};
-    use crate::tmcmc::Silent;
+    use chatter_progress::Silent;
 
     #[test]
     fn options_are_validated() {

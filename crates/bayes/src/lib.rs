@@ -8,6 +8,7 @@
 //! | [`tmcmc`] | TMCMC / iTMCMC with the log-evidence ln p(D), data fit and information gain, model-class probabilities | Ching and Chen 2007; Betz, Papaioannou and Straub 2016; 000 Eq. 32-33 |
 //! | [`rejection`] | rejection sampling: keep theta with probability L / L_max | 004 Section 4-5 |
 //! | [`amcmc`] | parallel adaptive MCMC with j candidates and k draws from the Eq. 8 stationary distribution, until s unique samples | 004 Section 5, Eq. 8 |
+//! | [`special`] | log-sum-exp, log-mean-exp and normalized log weights; the standard normal distribution function and its inverse | Numerical Recipes erfcc; Acklam |
 //! | [`gp`] | Gaussian-process regression with a Matérn 3/2 or 5/2 kernel, hyperparameters by maximum marginal likelihood: a surrogate of expensive model outputs | 002 Section 3.3 |
 //!
 //! Everything is in log space. Every stochastic routine takes a seed and draws from per-chain (or
@@ -22,7 +23,8 @@
 //! use chatter_bayes::amcmc::{adaptive_mcmc, AmcmcOptions};
 //! use chatter_bayes::prior::{IndependentPrior, Marginal};
 //! use chatter_bayes::rejection::{rejection_sample, LikelihoodBound};
-//! use chatter_bayes::tmcmc::{tmcmc, Silent, TmcmcOptions};
+//! use chatter_bayes::tmcmc::{tmcmc, TmcmcOptions};
+//! use chatter_progress::Silent;
 //! let prior = IndependentPrior::new(vec![Marginal::Normal { mean: 0.0, sd: 1.0 }])?;
 //! let sd: f64 = 0.5;
 //! let like = |t: &[f64]| -0.5 * ((t[0] - 1.0) / sd).powi(2) - (sd * (2.0 * std::f64::consts::PI).sqrt()).ln();
@@ -56,6 +58,7 @@ pub mod gp;
 pub mod prior;
 pub mod rejection;
 pub mod samples;
+pub mod special;
 pub mod tmcmc;
 
 pub use error::{BayesError, Result};

@@ -2,6 +2,7 @@
 //! correlated multivariate normal (given by its mean and covariance, or estimated from samples).
 
 use crate::error::{BayesError, Result};
+use crate::special::normal_cdf;
 use rand_distr::{Distribution, StandardNormal};
 use std::f64::consts::PI;
 
@@ -52,28 +53,6 @@ pub enum Marginal {
         /// Standard deviation of ln x.
         sigma: f64,
     },
-}
-
-fn std_normal_cdf(x: f64) -> f64 {
-    0.5 * erfc(-x / std::f64::consts::SQRT_2)
-}
-
-/// Complementary error function (Numerical Recipes erfcc, relative error < 1.2e-7).
-pub fn erfc(x: f64) -> f64 {
-    let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t
-        * (-z * z - 1.265_512_23
-            + t * (1.000_023_68
-                + t * (0.374_091_96
-                    + t * (0.096_784_18
-                        + t * (-0.186_288_06
-                            + t * (0.278_868_07
-                                + t * (-1.135_203_98
-                                    + t * (1.488_515_87
-                                        + t * (-0.822_152_23 + t * 0.170_872_77)))))))))
-            .exp();
-    if x >= 0.0 { r } else { 2.0 - r }
 }
 
 impl Marginal {
@@ -134,7 +113,7 @@ impl Marginal {
                 if !(low..=high).contains(&x) {
                     return f64::NEG_INFINITY;
                 }
-                let mass = std_normal_cdf((high - mean) / sd) - std_normal_cdf((low - mean) / sd);
+                let mass = normal_cdf((high - mean) / sd) - normal_cdf((low - mean) / sd);
                 let z = (x - mean) / sd;
                 -0.5 * z * z - sd.ln() - 0.5 * (2.0 * PI).ln() - mass.ln()
             }

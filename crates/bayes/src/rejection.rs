@@ -16,7 +16,8 @@
 
 use crate::error::{BayesError, Result};
 use crate::prior::Prior;
-use crate::tmcmc::{LogLikelihood, log_mean_exp, stream};
+use crate::special::log_mean_exp;
+use crate::tmcmc::{LogLikelihood, stream};
 use rand::Rng;
 use rayon::prelude::*;
 

@@ -14,6 +14,8 @@
 use crate::error::{BayesError, Result};
 use crate::prior::Prior;
 use crate::samples::SampleSet;
+use crate::special::{log_mean_exp, normalized_weights};
+use chatter_progress::Observer;
 use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -72,20 +74,6 @@ impl<F: Fn(&[f64]) -> f64 + Sync> LogLikelihood for F {
         self(theta)
     }
 }
-
-/// Progress of a sampler; no-op by default.
-pub trait SamplerObserver: Sync {
-    /// After each stage: index, beta, acceptance rate.
-    fn stage(&self, _index: usize, _beta: f64, _acceptance: f64) {}
-    /// During a chain sampler (adaptive MCMC): `done` of `total` unique samples collected by
-    /// `chain`.
-    fn chain_progress(&self, _chain: usize, _done: usize, _total: usize) {}
-}
-
-/// The observer that does nothing.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Silent;
-impl SamplerObserver for Silent {}
 
 /// Which variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,15 +158,6 @@ pub(crate) fn stream(seed: u64, stage: usize, chain: usize) -> StdRng {
     StdRng::seed_from_u64(z ^ (z >> 31))
 }
 
-/// ln mean exp(x), shifted by the maximum so that nothing overflows.
-pub(crate) fn log_mean_exp(x: &[f64]) -> f64 {
-    let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if !m.is_finite() {
-        return m;
-    }
-    m + (x.iter().map(|v| (v - m).exp()).sum::<f64>() / x.len() as f64).ln()
-}
-
 fn cov_of_weights(ln_l: &[f64], dbeta: f64) -> f64 {
     let m = ln_l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let w: Vec<f64> = ln_l.iter().map(|l| (dbeta * (l - m)).exp()).collect();
@@ -192,7 +171,7 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
     prior: &P,
     likelihood: &L,
     options: &TmcmcOptions,
-    observer: &dyn SamplerObserver,
+    observer: &dyn Observer,
 ) -> Result<TmcmcResult> {
     let n = options.samples;
     let d = prior.dimension();
@@ -244,10 +223,7 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         beta = (beta + dbeta).min(1.0);
         let ln_w: Vec<f64> = ln_l.iter().map(|l| dbeta * l).collect();
         log_evidence += log_mean_exp(&ln_w);
-        let m = ln_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let w: Vec<f64> = ln_w.iter().map(|x| (x - m).exp()).collect();
-        let total: f64 = w.iter().sum();
-        let weights: Vec<f64> = w.iter().map(|x| x / total).collect();
+        let weights = normalized_weights(&ln_w);
         let chol = proposal_factor(&theta, &weights)?;
         // systematic resampling (deterministic given the weights and one uniform per stage)
         let mut rng = stream(options.seed, stage, usize::MAX);

@@ -5,7 +5,8 @@
 
 use chatter_bayes::prior::{MultivariateNormalPrior, Prior};
 use chatter_bayes::rejection::{LikelihoodBound, rejection_sample};
-use chatter_bayes::tmcmc::{Silent, TmcmcOptions, tmcmc};
+use chatter_bayes::tmcmc::{TmcmcOptions, tmcmc};
+use chatter_progress::Silent;
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 use rand::SeedableRng;
 use std::f64::consts::PI;

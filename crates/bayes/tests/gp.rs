@@ -4,7 +4,8 @@
 
 use chatter_bayes::gp::{GaussianProcess, GpOptions, Kernel, MeanFunction};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
-use chatter_bayes::tmcmc::{Silent, TmcmcOptions, tmcmc};
+use chatter_bayes::tmcmc::{TmcmcOptions, tmcmc};
+use chatter_progress::Silent;
 use std::f64::consts::PI;
 
 fn grid_1d(n: usize, low: f64, high: f64) -> Vec<Vec<f64>> {

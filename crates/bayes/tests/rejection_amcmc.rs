@@ -5,7 +5,7 @@
 use chatter_bayes::amcmc::{AmcmcOptions, AmcmcResult, adaptive_mcmc};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_bayes::rejection::{LikelihoodBound, rejection_sample};
-use chatter_bayes::tmcmc::Silent;
+use chatter_progress::Silent;
 use std::f64::consts::PI;
 
 /// Observation of the conjugate problem.

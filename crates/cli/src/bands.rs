@@ -535,7 +535,7 @@ fn montecarlo(
         samples,
         req.seed.unwrap_or(0),
         speeds,
-        &|done, _| bar.set(done),
+        &bar,
     )
     .map_err(crate::job_error)?;
     bar.finish();

@@ -4,9 +4,10 @@ use crate::output::Folder;
 use crate::plot::{Markers, Series, line_chart_svg};
 use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
-use chatter_gap::{Diagnosis, DiagnosisObserver, EffectClass, Validation};
+use chatter_gap::{Diagnosis, EffectClass, Validation};
 use chatter_jobs::diagnose::{DiagnoseRequest as JobRequest, diagnose};
 use chatter_jobs::inference_data::{Draws, InferenceData};
+use chatter_progress::Observer;
 use plotters::style::{BLUE, RED};
 use std::io::Write;
 use std::path::Path;
@@ -66,12 +67,12 @@ struct Progress {
     done: AtomicUsize,
 }
 
-impl DiagnosisObserver for Progress {
-    fn class_done(&self, _class: EffectClass, _log_evidence: f64) {
+impl Observer for Progress {
+    fn class_done(&self, _class: &str, _log_evidence: f64) {
         let k = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         self.bar.set(k);
     }
-    fn fold_done(&self, _done: usize, _total: usize) {
+    fn steps_done(&self, _done: usize, _total: usize) {
         let k = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         self.bar.set(k);
     }

@@ -4,7 +4,7 @@
 use crate::progress::Bar;
 use anyhow::{Context, Result};
 use chatter_jobs::plan::PlanRequest;
-use chatter_updating::ensemble::EnsembleObserver;
+
 use chatter_updating::parameters::parse_model_parameters;
 use chatter_updating::plan::Strategy;
 use chatter_updating::update::PriorOverrides;
@@ -74,14 +74,6 @@ pub struct PlanArgs {
     /// One self-contained HTML page: inputs, plots, numbers, next test, warnings.
     #[arg(long)]
     report: Option<PathBuf>,
-}
-
-struct PathProgress(Bar);
-
-impl EnsembleObserver for PathProgress {
-    fn paths_done(&self, done: usize, _total: usize) {
-        self.0.set(done);
-    }
 }
 
 /// Run `chatter plan`: print the next cut as JSON on stdout.
@@ -177,10 +169,10 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         sigma_depth_mm: args.sigma_depth_mm,
         sigma_chatter_hz: args.sigma_chatter_hz,
     };
-    let progress = PathProgress(Bar::new(args.paths as u64, "sampled boundaries", quiet));
+    let progress = Bar::new(args.paths as u64, "sampled boundaries", quiet);
     let outcome = chatter_jobs::plan::plan(&model, &observations, &request, &progress)
         .map_err(crate::job_error)?;
-    progress.0.finish();
+    progress.finish();
     if let Some(t) = outcome.next_cut.filter(|t| t.on_contour == Some(false)) {
         eprintln!(
             "warning: the P_s = {} contour at {} rpm lies above the deepest candidate depth; \

@@ -4,7 +4,7 @@
 //! pipe) one line at most every [`LOG_EVERY`] with done/total, the elapsed time and the ETA, so
 //! that long runs are visible in logs too.
 
-use chatter_stability::boundary::BoundaryObserver;
+use chatter_progress::Observer;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::Mutex;
@@ -90,14 +90,13 @@ impl Bar {
     }
 }
 
-impl BoundaryObserver for Bar {
-    fn speed_done(&self, done: usize, _total: usize) {
+/// Steps (speeds, paths) set the position; a fraction sets it in thousandths (a bar of 1000).
+impl Observer for Bar {
+    fn steps_done(&self, done: usize, _total: usize) {
         self.set(done);
     }
-}
 
-impl chatter_dynamics::simulate::SimulationObserver for Bar {
-    fn progress(&self, fraction: f64) {
+    fn fraction_done(&self, fraction: f64) {
         self.set((fraction * 1000.0) as usize);
     }
 }

@@ -4,10 +4,10 @@
 use crate::output::Folder;
 use crate::progress::Bar;
 use anyhow::{Context, Result, anyhow, bail};
-use chatter_bayes::tmcmc::SamplerObserver;
 use chatter_jobs::inference_data::{Draws, InferenceData};
 use chatter_jobs::update::{PreparedUpdate, UpdateRequest};
-use chatter_updating::classes::{ClassObserver, Sampler};
+use chatter_progress::Observer;
+use chatter_updating::classes::Sampler;
 use chatter_updating::parameters::parse_model_parameters;
 use chatter_updating::update::{PriorOverrides, UpdateResult};
 use plotters::prelude::*;
@@ -86,7 +86,7 @@ pub enum SurrogateArg {
 /// Progress: one step per model class.
 struct ClassProgress(Bar);
 
-impl SamplerObserver for ClassProgress {
+impl Observer for ClassProgress {
     fn stage(&self, index: usize, beta: f64, acceptance: f64) {
         self.0.detail(&format!(
             "stage {index}, beta {beta:.3}, acceptance {acceptance:.2}"
@@ -96,9 +96,7 @@ impl SamplerObserver for ClassProgress {
         self.0
             .detail(&format!("chain {chain}: {done}/{total} samples"));
     }
-}
 
-impl ClassObserver for ClassProgress {
     fn class_started(&self, index: usize, _total: usize, _alpha: f64) {
         self.0.set(index);
     }

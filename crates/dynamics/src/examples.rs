@@ -1,5 +1,6 @@
-//! Reference models shipped with the toolkit: the seeds' cases (the JSON files in the
-//! repository's `examples/` folder, embedded here) and the classic single-DOF milling benchmark.
+//! Reference models shipped with the toolkit: the seeds' cases (the JSON files in this crate's
+//! `data/` folder, embedded here; the repository's `examples/` folder links to them) and the
+//! classic single-DOF milling benchmark.
 //! Tests, benches and `chatter demo` share them.
 
 use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
@@ -8,27 +9,24 @@ use crate::operation::{Milling, MillingDirection, Operation, Turning};
 use std::path::Path;
 
 /// Model file of the turning case of Ahmadi (2022), seed 000, Table 1.
-pub const AHMADI_2022_TURNING_MODEL: &str =
-    include_str!("../../../examples/ahmadi2022_turning_model.json");
+pub const AHMADI_2022_TURNING_MODEL: &str = include_str!("../data/ahmadi2022_turning_model.json");
 /// Observations of the turning case of seed 000: Table 2 poles and the Fig. 2 cuts.
 pub const AHMADI_2022_TURNING_OBSERVATIONS: &str =
-    include_str!("../../../examples/ahmadi2022_turning_observations.json");
+    include_str!("../data/ahmadi2022_turning_observations.json");
 /// Model file of the milling example of Schmitz (2023), seed 001.
-pub const SCHMITZ_2023_MILLING_MODEL: &str =
-    include_str!("../../../examples/schmitz2023_milling_model.json");
+pub const SCHMITZ_2023_MILLING_MODEL: &str = include_str!("../data/schmitz2023_milling_model.json");
 /// Model file of the experimental milling case of Ebrahimi-Tirtashi and Ahmadi (2025), seed 002.
 pub const EBRAHIMI_2025_MILLING_MODEL: &str =
-    include_str!("../../../examples/ebrahimi2025_milling_model.json");
+    include_str!("../data/ebrahimi2025_milling_model.json");
 /// Model file of the flexure of Karandikar, Tyler and Schmitz (seed 003), stiffness and damping
 /// calibrated to the paper's prior probabilities of stability.
-pub const KARANDIKAR_FLEXURE_MODEL: &str =
-    include_str!("../../../examples/karandikar_flexure_model.json");
+pub const KARANDIKAR_FLEXURE_MODEL: &str = include_str!("../data/karandikar_flexure_model.json");
 /// Observations of seed 003: the cuts its text reports.
 pub const KARANDIKAR_FLEXURE_OBSERVATIONS: &str =
-    include_str!("../../../examples/karandikar_flexure_observations.json");
+    include_str!("../data/karandikar_flexure_observations.json");
 /// Observations of seed 002: Table 2 poles and their stable cuts.
 pub const EBRAHIMI_2025_MILLING_OBSERVATIONS: &str =
-    include_str!("../../../examples/ebrahimi2025_milling_observations.json");
+    include_str!("../data/ebrahimi2025_milling_observations.json");
 
 fn embedded_model(text: &str, name: &str) -> ModalModel {
     // The embedded files are checked by this crate's tests; failure here is a build defect.

@@ -35,6 +35,7 @@ use crate::error::{DynamicsError, Result, positive};
 use crate::model::ModalModel;
 use crate::operation::Operation;
 use crate::resample::Resampler;
+use chatter_progress::{Observer, Silent};
 use nalgebra::Matrix4;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -147,15 +148,6 @@ pub struct Simulation {
     pub lost_contact_fraction: f64,
 }
 
-/// Progress of long simulations; no-op by default.
-pub trait SimulationObserver {
-    /// Fraction of the record done, in [0, 1].
-    fn progress(&self, _fraction: f64) {}
-}
-
-struct Silent;
-impl SimulationObserver for Silent {}
-
 /// Fewest internal steps per period of the highest mode. With the cutting force interpolated
 /// linearly over each step (first-order hold, the slope extrapolated from the previous step) the
 /// local error of the regenerative loop is of second order in the step: 100 steps per period
@@ -222,7 +214,7 @@ pub fn internal_step(f_max_hz: f64, tau_s: f64, min_steps: usize) -> (f64, usize
 pub fn simulate_with_observer(
     model: &ModalModel,
     settings: &SimulationSettings,
-    observer: &dyn SimulationObserver,
+    observer: &dyn Observer,
 ) -> Result<Simulation> {
     settings.validate()?;
     model.require_proportional("the time-domain simulation")?;
@@ -442,10 +434,10 @@ pub fn simulate_with_observer(
             ));
         }
         if step % report_every == 0 {
-            observer.progress(step as f64 / total_steps as f64);
+            observer.fraction_done(step as f64 / total_steps as f64);
         }
     }
-    observer.progress(1.0);
+    observer.fraction_done(1.0);
     // once-per-revolution pulses at the output samples nearest each revolution start
     let rev_s = 60.0 / settings.speed_rpm;
     let mut pulse = vec![0.0; n_out];

@@ -150,7 +150,7 @@ fn cut_tables_as_csv() {
 
 #[test]
 fn examples_parse_and_round_trip() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data");
     let mut models = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
@@ -222,9 +222,9 @@ proptest! {
     }
 }
 
-/// The example files of the repository (models and observations).
+/// The example files of this crate (models and observations; `data/`).
 fn example_texts() -> Vec<(String, bool)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data");
     [
         ("schmitz2023_milling_model.json", true),
         ("ahmadi2022_turning_model.json", true),

@@ -14,9 +14,10 @@ mod common;
 use chatter_gap::generator::{proving_machines, true_variant};
 use chatter_gap::predict::inference_solver;
 use chatter_gap::{
-    DiagnoseOptions, DiagnosisObserver, EffectClass, HiddenEffect, Recalibration, Scenario,
-    Validation, Variant, diagnose, synthesize,
+    DiagnoseOptions, EffectClass, HiddenEffect, Recalibration, Scenario, Validation, Variant,
+    diagnose, synthesize,
 };
+use chatter_progress::Observer;
 use common::{arg, list};
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -49,8 +50,8 @@ fn balanced_misclassification(variant: &Variant, cuts: &[(f64, f64, f64, bool)])
 
 /// Prints each class's evidence and the time since the diagnosis started (stderr).
 struct Log(Instant);
-impl DiagnosisObserver for Log {
-    fn class_done(&self, class: EffectClass, log_evidence: f64) {
+impl Observer for Log {
+    fn class_done(&self, class: &str, log_evidence: f64) {
         eprintln!(
             "  {class}: ln Z {log_evidence:.1} at {:.1} s",
             self.0.elapsed().as_secs_f64()

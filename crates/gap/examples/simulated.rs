@@ -15,7 +15,8 @@ mod shop;
 mod common;
 
 use chatter_gap::generator::proving_machines;
-use chatter_gap::{DiagnoseOptions, EffectClass, Quiet, Scenario, Validation, diagnose};
+use chatter_gap::{DiagnoseOptions, EffectClass, Scenario, Validation, diagnose};
+use chatter_progress::Silent;
 use common::{arg, list};
 use std::time::Instant;
 
@@ -61,7 +62,7 @@ fn main() -> chatter_gap::Result<()> {
                         seed,
                         ..options.clone()
                     },
-                    &Quiet,
+                    &Silent,
                 )?;
                 if verbose {
                     for c in &data.cuts {

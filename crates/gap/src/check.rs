@@ -16,7 +16,7 @@
 use crate::data::Dataset;
 use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals};
 use crate::predict::Prediction;
-use chatter_bayes::prior::erfc;
+use chatter_bayes::special::normal_cdf;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use serde::Serialize;
@@ -44,17 +44,12 @@ pub struct PredictiveCheck {
     pub passed: bool,
 }
 
-/// Upper tail of the standard normal.
-fn upper_normal(z: f64) -> f64 {
-    0.5 * erfc(z / std::f64::consts::SQRT_2)
-}
-
 /// P(chi^2_n >= t) by the Wilson-Hilferty approximation.
 fn chi_square_tail(t: f64, n: usize) -> f64 {
     let n = n as f64;
     let v = 2.0 / (9.0 * n);
     let z = ((t / n).cbrt() - (1.0 - v)) / v.sqrt();
-    upper_normal(z)
+    normal_cdf(-z)
 }
 
 /// The check over posterior-sample predictions of `data`.

@@ -5,16 +5,18 @@ use crate::classes::{ClassModel, EffectClass, Nominal, unavailable};
 use crate::data::Dataset;
 use crate::equivalence::largest_shift;
 use crate::error::{GapError, Result};
-use crate::likelihood::{NoiseModel, log_sum_exp, terms};
+use crate::likelihood::{NoiseModel, terms};
 use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
 use crate::shrink::{Shrink, ValidationReport, shrink};
 use crate::variant::Variant;
 use chatter_bayes::Prior;
+use chatter_bayes::special::log_sum_exp;
 use chatter_bayes::tmcmc::{
-    Silent, TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, rejuvenate, tmcmc,
+    TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, rejuvenate, tmcmc,
 };
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_progress::{Observer, Silent};
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::Discretization;
 use rand::SeedableRng;
@@ -197,19 +199,6 @@ pub enum Validation {
     /// No held-out validation.
     Off,
 }
-
-/// Progress of a diagnosis; no-op by default.
-pub trait DiagnosisObserver: Sync {
-    /// A class's evidence is known.
-    fn class_done(&self, _class: EffectClass, _log_evidence: f64) {}
-    /// A validation fold is done.
-    fn fold_done(&self, _done: usize, _total: usize) {}
-}
-
-/// The observer that does nothing.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Quiet;
-impl DiagnosisObserver for Quiet {}
 
 /// The verdict: the nominal model explains the data, a class explains the gap, or none does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -589,7 +578,7 @@ pub fn diagnose(
     model: &ModalModel,
     observations: &Observations,
     options: &DiagnoseOptions,
-    observer: &dyn DiagnosisObserver,
+    observer: &dyn Observer,
 ) -> Result<Diagnosis> {
     let options = options.validated()?;
     let Prepared { nominal, data } = prepare(model, observations, &options.noise)?;
@@ -615,7 +604,7 @@ pub fn diagnose(
             options.samples,
             class_seed(options.seed, class, 0),
         )?;
-        observer.class_done(class, f.run.log_evidence);
+        observer.class_done(class.name(), f.run.log_evidence);
         fitted.push(f);
     }
     let evidences: Vec<f64> = fitted.iter().map(|f| f.run.log_evidence).collect();

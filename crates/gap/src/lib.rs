@@ -54,10 +54,11 @@
 //! `examples/confusion.rs` prints the confusion matrix and the held-out closure.
 //!
 //! ```no_run
-//! use chatter_gap::{DiagnoseOptions, HiddenEffect, Quiet, Scenario, diagnose, nominal_milling, synthesize};
+//! use chatter_gap::{DiagnoseOptions, HiddenEffect, Scenario, diagnose, nominal_milling, synthesize};
+//! use chatter_progress::Silent;
 //! let nominal = nominal_milling()?;
 //! let data = synthesize(&nominal, &Scenario::new(HiddenEffect::ParameterError, 1))?;
-//! let report = diagnose(&nominal, &data, &DiagnoseOptions::default(), &Quiet)?;
+//! let report = diagnose(&nominal, &data, &DiagnoseOptions::default(), &Silent)?;
 //! assert_eq!(report.verdict.name(), "consistent");
 //! # Ok::<(), chatter_gap::GapError>(())
 //! ```
@@ -79,10 +80,7 @@ pub mod variant;
 
 pub use check::PredictiveCheck;
 pub use classes::EffectClass;
-pub use diagnose::{
-    DiagnoseOptions, Diagnosis, DiagnosisObserver, LobeComparison, Quiet, Validation, Verdict,
-    diagnose,
-};
+pub use diagnose::{DiagnoseOptions, Diagnosis, LobeComparison, Validation, Verdict, diagnose};
 pub use error::{GapError, Result};
 pub use generator::{HiddenEffect, Recalibration, RunOrder, Scenario, nominal_milling, synthesize};
 pub use likelihood::NoiseModel;

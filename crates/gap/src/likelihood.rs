@@ -16,7 +16,7 @@
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
 use crate::predict::{CutPrediction, PredictedPole, Prediction};
-use chatter_bayes::prior::erfc;
+use chatter_bayes::special::{log_sum_exp, normal_cdf};
 use serde::{Deserialize, Serialize};
 
 /// The noise assumed in the observations. Defaults in [`NoiseModel::default`].
@@ -105,7 +105,7 @@ impl NoiseModel {
         let phi = if log_distance.is_nan() {
             0.5
         } else {
-            0.5 * erfc(-log_distance / (self.label_width_log_depth * std::f64::consts::SQRT_2))
+            normal_cdf(log_distance / self.label_width_log_depth)
         };
         self.lapse + (1.0 - 2.0 * self.lapse) * phi
     }
@@ -132,15 +132,6 @@ fn ln_wrapped_normal(r: f64, s: f64, fold: f64) -> f64 {
             ln_normal(r + fold, s),
         ])
     }
-}
-
-/// ln sum_i e^{x_i}, shifted by the maximum so that no term overflows.
-pub(crate) fn log_sum_exp(x: &[f64]) -> f64 {
-    let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if !m.is_finite() {
-        return m;
-    }
-    m + x.iter().map(|v| (v - m).exp()).sum::<f64>().ln()
 }
 
 /// A chatter-frequency residual folded into [-f_tp / 2, f_tp / 2].

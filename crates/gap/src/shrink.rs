@@ -19,6 +19,7 @@ use crate::error::Result;
 use crate::likelihood::{NoiseModel, terms};
 use crate::predict::{Prediction, predict};
 use crate::regions::residuals;
+use chatter_bayes::special::log_mean_exp;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
@@ -82,14 +83,8 @@ impl Pool {
             return;
         }
         let all: Vec<_> = predictions.iter().map(|p| terms(p, data, noise)).collect();
-        let log_mean = |values: &mut dyn Iterator<Item = f64>| -> f64 {
-            let v: Vec<f64> = values.collect();
-            let m = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            if !m.is_finite() {
-                return m;
-            }
-            m + (v.iter().map(|x| (x - m).exp()).sum::<f64>() / v.len() as f64).ln()
-        };
+        let log_mean =
+            |values: &mut dyn Iterator<Item = f64>| log_mean_exp(&values.collect::<Vec<f64>>());
         for (i, c) in data.cuts.iter().enumerate() {
             self.lpd.push(log_mean(&mut all.iter().map(|t| t.cut(i))));
             let p = predictions
@@ -203,7 +198,7 @@ pub(crate) fn shrink(
     nominal: &Nominal,
     data: &Dataset,
     options: &DiagnoseOptions,
-    observer: &dyn crate::diagnose::DiagnosisObserver,
+    observer: &dyn chatter_progress::Observer,
 ) -> Result<Option<(Shrink, ValidationReport)>> {
     let Some((cut_fold, pole_fold, k)) = folds(data, options.validation, options.seed) else {
         return Ok(None);
@@ -232,7 +227,7 @@ pub(crate) fn shrink(
             &test,
             &options.noise,
         );
-        observer.fold_done(fold + 1, k);
+        observer.steps_done(fold + 1, k);
     }
     let metric = |b: Option<f64>, a: Option<f64>| match (b, a) {
         (Some(before), Some(after)) => Some(Metric { before, after }),

@@ -8,9 +8,10 @@
 
 use chatter_gap::generator::{effect_at, proving_machines};
 use chatter_gap::{
-    DiagnoseOptions, Diagnosis, EffectClass, HiddenEffect, Quiet, Recalibration, Scenario,
-    Validation, diagnose, nominal_milling, synthesize,
+    DiagnoseOptions, Diagnosis, EffectClass, HiddenEffect, Recalibration, Scenario, Validation,
+    diagnose, nominal_milling, synthesize,
 };
+use chatter_progress::Silent;
 
 fn options(seed: u64) -> DiagnoseOptions {
     DiagnoseOptions {
@@ -53,7 +54,7 @@ fn campaign(
         classes: classes.to_vec(),
         ..options(seed)
     };
-    let d = diagnose(&m.model, &data, &options, &Quiet).unwrap();
+    let d = diagnose(&m.model, &data, &options, &Silent).unwrap();
     eprintln!("{} / {effect:?}: {}", m.name, summary(&d));
     for c in &d.classes {
         assert!(!c.failures_flagged, "{}: {c:?}", c.name);
@@ -161,7 +162,7 @@ fn independent_of_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap();
-        let d = pool.install(|| diagnose(&nominal, &data, &options, &Quiet).unwrap());
+        let d = pool.install(|| diagnose(&nominal, &data, &options, &Silent).unwrap());
         serde_json::to_string(&d).unwrap()
     };
     assert_eq!(json(1), json(3));
@@ -172,7 +173,7 @@ fn independent_of_thread_count() {
 fn bad_input_is_rejected() {
     let nominal = nominal_milling().unwrap();
     let empty = chatter_dynamics::Observations::default();
-    let err = diagnose(&nominal, &empty, &DiagnoseOptions::default(), &Quiet).unwrap_err();
+    let err = diagnose(&nominal, &empty, &DiagnoseOptions::default(), &Silent).unwrap_err();
     assert!(err.to_string().contains("no cuts and no poles"), "{err}");
     let mut scenario = Scenario::new(HiddenEffect::ParameterError, 1);
     scenario.cuts = 4;
@@ -181,7 +182,7 @@ fn bad_input_is_rejected() {
         validation: Validation::KFold { folds: 1 },
         ..DiagnoseOptions::default()
     };
-    let err = diagnose(&nominal, &data, &options, &Quiet).unwrap_err();
+    let err = diagnose(&nominal, &data, &options, &Silent).unwrap_err();
     assert!(err.to_string().contains("folds"), "{err}");
     let options = DiagnoseOptions {
         noise: chatter_gap::NoiseModel {
@@ -190,6 +191,6 @@ fn bad_input_is_rejected() {
         },
         ..DiagnoseOptions::default()
     };
-    let err = diagnose(&nominal, &data, &options, &Quiet).unwrap_err();
+    let err = diagnose(&nominal, &data, &options, &Silent).unwrap_err();
     assert!(err.to_string().contains("noise.lapse"), "{err}");
 }

@@ -17,7 +17,8 @@ mod shop;
 
 use chatter_gap::generator::proving_machines;
 use chatter_gap::predict::inference_solver;
-use chatter_gap::{DiagnoseOptions, HiddenEffect, Quiet, Scenario, Validation, diagnose};
+use chatter_gap::{DiagnoseOptions, HiddenEffect, Scenario, Validation, diagnose};
+use chatter_progress::Silent;
 
 #[test]
 fn simulated_turning_control() {
@@ -56,7 +57,7 @@ fn simulated_turning_control() {
         validation: Validation::Off,
         ..DiagnoseOptions::default()
     };
-    let d = diagnose(&machine.model, &data, &options, &Quiet).unwrap();
+    let d = diagnose(&machine.model, &data, &options, &Silent).unwrap();
     eprintln!(
         "verdict {} (expected consistent); nominal ln L {:.1}, practical shift {:.2} sd, check {:?}",
         d.verdict.name(),

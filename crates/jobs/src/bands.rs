@@ -4,10 +4,10 @@
 
 use crate::error::{JobError, Result};
 use chatter_dynamics::ModalModel;
+use chatter_progress::Observer;
 use chatter_stability::Method;
-use chatter_stability::boundary::{BoundaryObserver, BoundaryOptions, LobePoint};
+use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_stability::monodromy::Discretization;
-use chatter_stability::zero_order::{ZeroOrderOptions, limiting_depths};
 use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
 use chatter_uncertainty::montecarlo::{
     QuantileBand, SampledBoundaries, StabilityMap, sample_boundaries,
@@ -18,22 +18,18 @@ use chatter_uncertainty::perturbation::{BoundRule, CredibilityPoint, model_momen
 /// Depths of a default grid.
 pub const DEFAULT_DEPTHS: usize = 100;
 
-/// Limiting depth per speed: zero-order lobes with the model's process damping and no
-/// ceiling, or the prepared discretization's root of |mu| = 1 (in parallel).
+/// Limiting depth per speed by the prepared `method` (in parallel), with the model's process
+/// damping (003) and the default depth ceiling, 100 mm (a "limit" of 200 m on a very stiff mode
+/// is none): the zero-order lobes or the discretization's root of |mu| = 1.
 pub fn lobes(
     model: &ModalModel,
     method: Method,
     speeds_rpm: &[f64],
-    observer: &dyn BoundaryObserver,
+    observer: &dyn Observer,
 ) -> Result<Vec<LobePoint>> {
-    Ok(match method {
-        // the model's process damping included (003), and the depth ceiling of the
-        // discretizations, 100 mm (a "limit" of 200 m on a very stiff mode is none)
-        Method::Zoa => limiting_depths(model, speeds_rpm, &ZeroOrderOptions::default())?,
-        Method::Fdm | Method::Sdm => method
-            .prepare(model, &BoundaryOptions::default())?
-            .lobes(speeds_rpm, observer)?,
-    })
+    Ok(method
+        .prepare(model, &BoundaryOptions::default())?
+        .lobes(speeds_rpm, observer)?)
 }
 
 /// Type B offsets around a lobe diagram.
@@ -60,7 +56,7 @@ pub fn geometric(
     method: Method,
     speeds_rpm: &[f64],
     offsets: TypeBOffsets,
-    observer: &dyn BoundaryObserver,
+    observer: &dyn Observer,
 ) -> Result<GeometricBands> {
     let lobes = lobes(model, method, speeds_rpm, observer)?;
     let bands = type_b_offsets(&finite_curve(&lobes), offsets)?;
@@ -125,7 +121,7 @@ pub fn perturbation(
             &mean_model,
             method,
             speeds_rpm,
-            &chatter_stability::boundary::Silent,
+            &chatter_progress::Silent,
         )?)?,
     };
     let grid = model_moment_grid(
@@ -181,7 +177,7 @@ impl MonteCarloBands {
 }
 
 /// `samples` draws of the distribution (seeded), the boundary of each at every speed by the
-/// discretization of `method` (004); `progress(done, total)` hears of each draw.
+/// discretization of `method` (004); `observer` hears of each draw.
 pub fn montecarlo(
     model: &ModalModel,
     distribution: &ParameterDistribution,
@@ -189,7 +185,7 @@ pub fn montecarlo(
     samples: usize,
     seed: u64,
     speeds_rpm: &[f64],
-    progress: &(dyn Fn(usize, usize) + Sync),
+    observer: &dyn Observer,
 ) -> Result<MonteCarloBands> {
     let discretization = discretization(method)?;
     let thetas = distribution.draws(samples, seed)?;
@@ -199,7 +195,7 @@ pub fn montecarlo(
         &thetas,
         speeds_rpm,
         &BoundaryOptions::default(),
-        progress,
+        observer,
     )?;
     let depth = sampled.depth_bands();
     let chatter_hz = sampled.chatter_frequency_bands();

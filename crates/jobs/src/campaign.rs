@@ -24,6 +24,7 @@ use crate::error::{JobError, Result};
 use crate::plan::{PlanRequest, plan};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_gap::Validation;
+use chatter_progress::Observer;
 use chatter_updating::plan::Strategy;
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -177,7 +178,7 @@ pub fn campaign_row(
         validation: options.validation,
         pointwise: false,
     };
-    let diagnosis = diagnose(model, observations, &request, &chatter_gap::diagnose::Quiet)?;
+    let diagnosis = diagnose(model, observations, &request, &chatter_progress::Silent)?;
     let mut speeds = observations.speeds_rpm();
     speeds.sort_by(f64::total_cmp);
     speeds.dedup();
@@ -200,7 +201,7 @@ pub fn campaign_row(
         diagnosis.diagnosed_model(),
         observations,
         &plan_request,
-        &chatter_updating::ensemble::Silent,
+        &chatter_progress::Silent,
     )?;
     let next = outcome.next_cut.filter(|_| !outcome.stop);
     Ok(CampaignRow {
@@ -238,11 +239,11 @@ pub fn campaign_line(campaign: &Campaign, options: &CampaignOptions) -> String {
 
 /// Every campaign in parallel (rayon), the table in manifest order: the header, then one line
 /// per campaign. Each campaign is seeded by its own line, so the table does not depend on the
-/// number of threads; `done(k, total)` hears of each finished campaign.
+/// number of threads; `observer` hears of each finished campaign.
 pub fn run_batch(
     campaigns: &[Campaign],
     options: &CampaignOptions,
-    done: &(dyn Fn(usize, usize) + Sync),
+    observer: &dyn Observer,
 ) -> String {
     let finished = std::sync::atomic::AtomicUsize::new(0);
     let lines: Vec<String> = campaigns
@@ -250,7 +251,7 @@ pub fn run_batch(
         .map(|c| {
             let line = campaign_line(c, options);
             let k = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            done(k, campaigns.len());
+            observer.steps_done(k, campaigns.len());
             line
         })
         .collect();

@@ -3,7 +3,8 @@
 
 use crate::error::{JobError, Result, count};
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_gap::{DiagnoseOptions, Diagnosis, DiagnosisObserver, Validation};
+use chatter_gap::{DiagnoseOptions, Diagnosis, Validation};
+use chatter_progress::Observer;
 
 /// Default samples per model class.
 pub const DEFAULT_SAMPLES: usize = 120;
@@ -51,7 +52,7 @@ pub fn diagnose(
     model: &ModalModel,
     observations: &Observations,
     request: &DiagnoseRequest,
-    observer: &dyn DiagnosisObserver,
+    observer: &dyn Observer,
 ) -> Result<Diagnosis> {
     check(observations, request)?;
     let options = DiagnoseOptions {

@@ -4,7 +4,8 @@
 use crate::error::{JobError, Result, count};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_updating::cuts::CutKernel;
-use chatter_updating::ensemble::EnsembleObserver;
+use chatter_progress::Observer;
+
 use chatter_updating::parameters::ModelParameter;
 use chatter_updating::plan::{PlanOutcome, PlanSettings, Strategy, plan_next_cut};
 use chatter_updating::update::PriorOverrides;
@@ -107,7 +108,7 @@ pub fn plan(
     model: &ModalModel,
     observations: &Observations,
     request: &PlanRequest,
-    observer: &dyn EnsembleObserver,
+    observer: &dyn Observer,
 ) -> Result<PlanOutcome> {
     Ok(plan_next_cut(
         model,

@@ -4,7 +4,8 @@
 
 use crate::error::{Result, count};
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_updating::classes::{ClassObserver, Sampler, SamplerOptions};
+use chatter_progress::Observer;
+use chatter_updating::classes::{Sampler, SamplerOptions};
 use chatter_updating::parameters::ModelParameter;
 use chatter_updating::update::{PriorOverrides, UpdateJob, UpdateResult, UpdateSettings};
 
@@ -108,7 +109,7 @@ impl PreparedUpdate {
     }
 
     /// Sample every class, summarize the selected one, draw the prior.
-    pub fn run(&self, observer: &dyn ClassObserver) -> Result<UpdateOutcome> {
+    pub fn run(&self, observer: &dyn Observer) -> Result<UpdateOutcome> {
         let options = SamplerOptions {
             sampler: self.request.sampler,
             samples: self.request.samples,

@@ -2,7 +2,8 @@
 //! (`turning`: the seed-000 lathe; `flexure`: the 003-like flexure with and without process
 //! damping C = 2.5e5 N/m against FDM at 1600 steps, issue 14).
 use chatter_dynamics::examples;
-use chatter_stability::boundary::{BoundaryOptions, Silent, lobe_diagram};
+use chatter_progress::Silent;
+use chatter_stability::boundary::{BoundaryOptions, lobe_diagram};
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::zero_order::zoa_lobes;
 

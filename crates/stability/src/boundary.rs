@@ -11,6 +11,7 @@ use crate::StabilitySolver;
 use crate::error::{Result, StabilityError, invalid};
 use crate::root::{Bracket, illinois};
 use chatter_dynamics::ModalModel;
+use chatter_progress::Observer;
 use rayon::prelude::*;
 
 /// Most Illinois steps refining a bracketed limiting depth.
@@ -93,22 +94,24 @@ impl LobePoint {
         }
     }
 
+    /// The point of the shallowest lobe crossing at `speed_rpm`, `crossing` = (depth m, chatter
+    /// Hz): [`Self::unbounded`] where no lobe crosses or the crossing lies above `max_depth_m`.
+    pub fn below_ceiling(speed_rpm: f64, crossing: Option<(f64, f64)>, max_depth_m: f64) -> Self {
+        match crossing {
+            Some((depth_m, chatter_hz)) if depth_m <= max_depth_m => Self {
+                speed_rpm,
+                depth_m,
+                chatter_hz,
+            },
+            _ => Self::unbounded(speed_rpm),
+        }
+    }
+
     /// Limiting depth in mm.
     pub fn depth_mm(&self) -> f64 {
         self.depth_m * 1e3
     }
 }
-
-/// Progress of long boundary computations; no-op by default.
-pub trait BoundaryObserver: Sync {
-    /// Called after each speed is done with the number done and the total.
-    fn speed_done(&self, _done: usize, _total: usize) {}
-}
-
-/// The observer that does nothing.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Silent;
-impl BoundaryObserver for Silent {}
 
 /// The natural frequency (Hz) of the mode that dominates regenerative chatter: the largest
 /// negative real part of the oriented FRF over the modes' resonances.
@@ -359,15 +362,27 @@ pub fn lobe_diagram<S: StabilitySolver + ?Sized>(
     model: &ModalModel,
     speeds_rpm: &[f64],
     options: &BoundaryOptions,
-    observer: &dyn BoundaryObserver,
+    observer: &dyn Observer,
+) -> Result<Vec<LobePoint>> {
+    in_parallel(speeds_rpm, observer, |s| {
+        limiting_depth(solver, model, s, options)
+    })
+}
+
+/// `point` at every speed of `speeds_rpm`, in parallel and in order; `observer` hears of each
+/// speed done.
+pub(crate) fn in_parallel(
+    speeds_rpm: &[f64],
+    observer: &dyn Observer,
+    point: impl Fn(f64) -> Result<LobePoint> + Sync,
 ) -> Result<Vec<LobePoint>> {
     let done = std::sync::atomic::AtomicUsize::new(0);
     speeds_rpm
         .par_iter()
         .map(|&s| {
-            let p = limiting_depth(solver, model, s, options);
+            let p = point(s);
             let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            observer.speed_done(k, speeds_rpm.len());
+            observer.steps_done(k, speeds_rpm.len());
             p
         })
         .collect()

@@ -1,41 +1,31 @@
 //! Closed-loop poles of turning from the characteristic equation (Ahmadi 2022, seed 000,
-//! Section 2.1, Eq. 5-6):
+//! Section 2.1, Eq. 5-6; the equation and its Newton step are in [`crate::characteristic`],
+//! with process damping).
 //!
-//! det D(lambda) = 0, D(lambda) = lambda^2 I + 2 Omega Z lambda + Omega^2 + a Phi^T K_c Phi (1 - e^{-lambda tau})
-//!
-//! (N x N in modal coordinates; our sign convention writes the force as -a K_c (x - x_tau)). Each
-//! structural pole lambda_n = -zeta_n w_n + i w_n sqrt(1 - zeta_n^2) (the root at a = 0) is
-//! continued in the width a by Newton's method with Jacobi's formula
-//! d/dlambda ln det D = tr(D^{-1} D'), D' = 2 lambda I + 2 Omega Z + a tau Phi^T K_c Phi e^{-lambda tau}.
-//! The dominant pole is the continued pole with the largest real part; its frequency is |lambda|
-//! and its damping -Re(lambda) / |lambda| (Eq. 6).
-//!
-//! Process damping (003 Eq. 1), F_d = -a D xdot with the constant D = (C / V) e_feed e_feed^T of
-//! turning ([`ModalModel::process_damping_matrix`]), adds a lambda Phi^T D Phi to D(lambda) and
-//! a Phi^T D Phi to D'(lambda): exact, as in the discretizations, since nothing is averaged.
+//! Each structural pole lambda_n = -zeta_n w_n + i w_n sqrt(1 - zeta_n^2) (the root at a = 0) is
+//! continued in the width a by Newton's method. The dominant pole is the root with the largest
+//! real part from a grid of starts ([`dominant_pole`]); its frequency is |lambda| and its damping
+//! -Re(lambda) / |lambda| (Eq. 6).
 
 use crate::StabilitySolver;
+use crate::characteristic::Characteristic;
 use crate::error::{Result, StabilityError, check_condition};
 use crate::multiplier::DominantMultiplier;
-use crate::resonance::{SUBSTRUCTURAL, near_harmonic};
+use crate::resonance::{near_harmonic, resonance_floor_hz};
+use chatter_dynamics::ModalModel;
 use chatter_dynamics::pole::pole_frequency_damping;
-use chatter_dynamics::{ModalModel, Operation};
-use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
 /// Width steps of the continuation from a = 0.
 const CONTINUATION_STEPS: usize = 24;
-/// Newton iterations per step and their relative tolerance on lambda.
+/// Newton iterations per continuation step.
 const NEWTON_ITERATIONS: usize = 30;
-const NEWTON_TOL: f64 = 1e-13;
 /// Newton iterations from a grid start: a start a quarter of the root spacing from a root
 /// converges quadratically within a few; one that wanders is abandoned.
 const GRID_NEWTON_ITERATIONS: usize = 12;
 /// Starts -x / tau on the negative real axis of the dominant-root search.
 const REAL_STARTS: [f64; 4] = [0.05, 0.3, 1.0, 3.0];
-/// A relative Newton step below which a step that stops shrinking is round-off.
-const ROUND_OFF_TOL: f64 = 1e-10;
 
 /// A closed-loop pole with its frequency and damping (000 Eq. 6).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,125 +49,19 @@ impl ClosedLoopPole {
     }
 }
 
-struct Characteristic {
-    omegas: Vec<f64>,
-    zetas: Vec<f64>,
-    coupling: DMatrix<f64>,
-    /// Phi^T D Phi: process damping per unit width in modal coordinates (zero without it).
-    process_damping: DMatrix<f64>,
-    tau: f64,
-}
-
-impl Characteristic {
-    fn new(model: &ModalModel, speed_rpm: f64) -> Result<Self> {
-        if !matches!(model.operation(), Operation::Turning(_)) {
-            return Err(StabilityError::Unsupported {
-                method: "frequency-domain poles",
-                reason: "the characteristic equation with constant K_c is for turning".into(),
-            });
-        }
-        model.require_proportional("the frequency-domain method")?;
-        let phi = model.shape_matrix();
-        let h = model.directional_matrix(0.0, speed_rpm);
-        let hm = DMatrix::from_fn(2, 2, |i, j| h[(i, j)]);
-        let d = model.process_damping_matrix(0.0, speed_rpm);
-        let dm = DMatrix::from_fn(2, 2, |i, j| d[(i, j)]);
-        Ok(Self {
-            omegas: model.omegas_rad_s(),
-            zetas: model.damping_ratios(),
-            coupling: phi.transpose() * hm * &phi,
-            process_damping: phi.transpose() * dm * &phi,
-            tau: model.operation().delay_s(speed_rpm),
-        })
+/// The structural pole `lambda` continued in the width from a = 0 to `width_m` in
+/// [`CONTINUATION_STEPS`] steps, Newton at each.
+fn continue_pole(ch: &Characteristic, mut lambda: Complex64, width_m: f64) -> Result<Complex64> {
+    for k in 1..=CONTINUATION_STEPS {
+        let a = width_m * k as f64 / CONTINUATION_STEPS as f64;
+        lambda = ch.newton(lambda, a, NEWTON_ITERATIONS).ok_or_else(|| {
+            StabilityError::NoConvergence {
+                solver: "characteristic-equation Newton",
+                detail: format!("width {a} m"),
+            }
+        })?;
     }
-
-    /// Newton step 1 / tr(D^{-1} D') at width `a`. With one or two modes (most models inside
-    /// samplers) tr(D^{-1} D') = (det D)' / det D in closed form, without allocation.
-    fn newton_step(&self, lambda: Complex64, a: f64) -> Option<Complex64> {
-        let n = self.omegas.len();
-        let e = (-lambda * self.tau).exp();
-        let regen = Complex64::new(1.0, 0.0) - e;
-        let entry = |i: usize, j: usize| {
-            let mut v =
-                regen * a * self.coupling[(i, j)] + lambda * a * self.process_damping[(i, j)];
-            if i == j {
-                v += lambda * lambda
-                    + 2.0 * self.zetas[i] * self.omegas[i] * lambda
-                    + self.omegas[i] * self.omegas[i];
-            }
-            v
-        };
-        let derivative = |i: usize, j: usize| {
-            let mut v = e * a * self.tau * self.coupling[(i, j)] + a * self.process_damping[(i, j)];
-            if i == j {
-                v += 2.0 * lambda + 2.0 * self.zetas[i] * self.omegas[i];
-            }
-            v
-        };
-        let (det, det_derivative) = match n {
-            1 => (entry(0, 0), derivative(0, 0)),
-            2 => {
-                let (d00, d01, d10, d11) = (entry(0, 0), entry(0, 1), entry(1, 0), entry(1, 1));
-                let (p00, p01, p10, p11) = (
-                    derivative(0, 0),
-                    derivative(0, 1),
-                    derivative(1, 0),
-                    derivative(1, 1),
-                );
-                (
-                    d00 * d11 - d01 * d10,
-                    p00 * d11 + d00 * p11 - p01 * d10 - d01 * p10,
-                )
-            }
-            _ => {
-                let d = DMatrix::from_fn(n, n, entry);
-                let dd = DMatrix::from_fn(n, n, derivative);
-                // an exactly singular D means lambda is already a root: no step
-                let Some(x) = d.lu().solve(&dd) else {
-                    return Some(Complex64::new(0.0, 0.0));
-                };
-                let tr = x.trace();
-                return (tr.norm() > 0.0).then(|| Complex64::new(1.0, 0.0) / tr);
-            }
-        };
-        if det.norm() == 0.0 {
-            return Some(Complex64::new(0.0, 0.0));
-        }
-        (det_derivative.norm() > 0.0).then(|| det / det_derivative)
-    }
-
-    /// Newton from `lambda` at width `a`; `None` when it does not converge. Converged when the
-    /// step falls below `NEWTON_TOL` |lambda|, or below `ROUND_OFF_TOL` |lambda| without
-    /// shrinking further (the round-off floor of det D near a multiple or clustered root).
-    fn newton(&self, mut lambda: Complex64, a: f64, iterations: usize) -> Option<Complex64> {
-        let mut previous = f64::INFINITY;
-        for _ in 0..iterations {
-            let step = self.newton_step(lambda, a)?;
-            lambda -= step;
-            if !(lambda.re.is_finite() && lambda.im.is_finite()) {
-                return None;
-            }
-            let size = step.norm() / lambda.norm();
-            if size <= NEWTON_TOL || (size <= ROUND_OFF_TOL && size >= 0.5 * previous) {
-                return Some(lambda);
-            }
-            previous = size;
-        }
-        None
-    }
-
-    fn continue_pole(&self, mut lambda: Complex64, width_m: f64) -> Result<Complex64> {
-        for k in 1..=CONTINUATION_STEPS {
-            let a = width_m * k as f64 / CONTINUATION_STEPS as f64;
-            lambda = self.newton(lambda, a, NEWTON_ITERATIONS).ok_or_else(|| {
-                StabilityError::NoConvergence {
-                    solver: "characteristic-equation Newton",
-                    detail: format!("width {a} m"),
-                }
-            })?;
-        }
-        Ok(lambda)
-    }
+    Ok(lambda)
 }
 
 /// The closed-loop poles continued from every structural pole, at `speed_rpm` and width
@@ -206,7 +90,7 @@ fn continued_poles(
         .map(|m| {
             let (w, z) = (m.omega_rad_s(), m.damping_ratio());
             let start = Complex64::new(-z * w, w * (1.0 - z * z).sqrt());
-            ch.continue_pole(start, width_m).map(ClosedLoopPole::new)
+            continue_pole(&ch, start, width_m).map(ClosedLoopPole::new)
         })
         .collect())
 }
@@ -243,13 +127,10 @@ pub fn dominant_resonance_pole(
     width_m: f64,
 ) -> Result<ClosedLoopPole> {
     let tau = model.operation().delay_s(speed_rpm);
-    let lowest = model
-        .omegas_rad_s()
-        .into_iter()
-        .fold(f64::INFINITY, f64::min);
+    let floor_rad_s = 2.0 * PI * resonance_floor_hz(model);
     grid_roots(model, speed_rpm, width_m)?
         .into_iter()
-        .filter(|r| !near_harmonic((r * tau).exp()) && r.im >= SUBSTRUCTURAL * lowest)
+        .filter(|r| !near_harmonic((r * tau).exp()) && r.im >= floor_rad_s)
         .max_by(|a, b| a.re.total_cmp(&b.re))
         .map(ClosedLoopPole::new)
         .ok_or_else(|| no_root(speed_rpm, width_m))
@@ -298,21 +179,22 @@ fn no_root(speed_rpm: f64, width_m: f64) -> StabilityError {
 fn grid_roots(model: &ModalModel, speed_rpm: f64, width_m: f64) -> Result<Vec<Complex64>> {
     check_condition(speed_rpm, width_m)?;
     let ch = Characteristic::new(model, speed_rpm)?;
-    let spacing = 2.0 * PI / ch.tau / 4.0;
+    let tau = ch.delay_s();
+    let spacing = 2.0 * PI / tau / 4.0;
     // the real (non-oscillating) root of the slow surface regeneration, which dominates with
     // process damping at low speed: |lambda| ~ 1 / tau
-    let real_starts = REAL_STARTS.iter().map(|x| Complex64::new(-x / ch.tau, 0.0));
+    let real_starts = REAL_STARTS.iter().map(|x| Complex64::new(-x / tau, 0.0));
     // the cutting stiffness moves the roots of a deep cut away from the structural frequency:
     // the grid also covers sqrt(omega^2 + b W_ii), the frequency with the cut's mean stiffness
     let shifted = |i: usize| {
-        let w = ch.omegas[i];
-        (w * w + width_m * ch.coupling[(i, i)])
+        let w = ch.omegas_rad_s()[i];
+        (w * w + width_m * ch.coupling_diagonal(i))
             .max(0.01 * w * w)
             .sqrt()
     };
-    Ok((0..ch.omegas.len())
+    Ok((0..ch.omegas_rad_s().len())
         .flat_map(|i| {
-            let (w, w_cut) = (ch.omegas[i], shifted(i));
+            let (w, w_cut) = (ch.omegas_rad_s()[i], shifted(i));
             let below = ((w - w.min(w_cut) + 0.15 * w) / spacing).ceil() as i64;
             let above = ((w.max(w_cut) - w + 0.15 * w) / spacing).ceil() as i64;
             (-below..=above).map(move |j| Complex64::new(0.0, w + j as f64 * spacing))

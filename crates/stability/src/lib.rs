@@ -8,6 +8,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod boundary;
+pub mod characteristic;
 mod eigen;
 pub mod error;
 pub mod frequency_domain;

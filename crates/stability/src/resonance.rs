@@ -35,6 +35,17 @@ pub const HARMONIC_CLEARANCE: f64 = 0.02;
 /// Lowest resonance frequency, as a fraction of the lowest natural frequency.
 pub const SUBSTRUCTURAL: f64 = 0.85;
 
+/// The lowest frequency of a resonance (Hz): [`SUBSTRUCTURAL`] times the lowest natural
+/// frequency of `model` (infinite for a model without modes).
+pub fn resonance_floor_hz(model: &ModalModel) -> f64 {
+    SUBSTRUCTURAL
+        * model
+            .modes()
+            .iter()
+            .map(|m| m.frequency_hz())
+            .fold(f64::INFINITY, f64::min)
+}
+
 /// Multipliers (real ones or conjugate pairs) deflated at most before giving up.
 const MAX_DEFLATED: usize = 40;
 
@@ -200,17 +211,13 @@ impl Discretization {
         depth_m: f64,
     ) -> Result<(DominantMultiplier, f64)> {
         let op = self.monodromy(model, speed_rpm, depth_m)?;
-        let lowest_hz = model
-            .modes()
-            .iter()
-            .map(|m| m.frequency_hz())
-            .fold(f64::INFINITY, f64::min);
+        let floor_hz = resonance_floor_hz(model);
         op.dominant_eigenpair_where(|mu, vector| {
             if near_harmonic(mu) {
                 return None;
             }
             let (multiplier, f) = op.multiplier_and_frequency(model, mu, vector);
-            (f >= SUBSTRUCTURAL * lowest_hz).then_some((multiplier, f))
+            (f >= floor_hz).then_some((multiplier, f))
         })
     }
 }

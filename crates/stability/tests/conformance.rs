@@ -270,7 +270,7 @@ fn every_solver_on_every_reference_problem() {
                 }
             };
             let prepared = prepare(solver, &model);
-            let lobes = prepared.lobes(&speeds, &boundary::Silent).unwrap();
+            let lobes = prepared.lobes(&speeds, &chatter_progress::Silent).unwrap();
             let mut worst: f64 = 0.0;
             for (point, &reference) in lobes.iter().zip(&references) {
                 let error = (point.depth_m - reference) / reference;

@@ -107,7 +107,7 @@ fn turning_fdm_matches_exact_frequency_domain_solution() {
         &model,
         &speeds,
         &BoundaryOptions::default(),
-        &chatter_stability::boundary::Silent,
+        &chatter_progress::Silent,
     )
     .unwrap();
     for (z, f) in zoa.iter().zip(&fdm) {

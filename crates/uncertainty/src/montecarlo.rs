@@ -15,6 +15,7 @@
 //! does not stop the map.
 
 use crate::error::{Result, UncertaintyError};
+use chatter_progress::Observer;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_updating::parameters::Parameterization;
@@ -252,7 +253,7 @@ pub fn gaussian_draws(
 /// The boundary of the model of each parameter sample `thetas[s]` (see
 /// [`Parameterization::model`]: modal perturbations and the absolute cutting coefficients and
 /// process damping, all sampled) at every speed, in parallel over samples; the result does not
-/// depend on the thread count. `progress(done, total)` is called per sample.
+/// depend on the thread count. `observer` hears of each sample done.
 ///
 /// A sample that gives no valid model, or whose boundary search fails at a speed, is recorded in
 /// [`SampledBoundaries::failures`] with a NaN limit and the map goes on; only invalid options
@@ -263,7 +264,7 @@ pub fn sample_boundaries<S: StabilitySolver + ?Sized>(
     thetas: &[Vec<f64>],
     speeds_rpm: &[f64],
     options: &BoundaryOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
+    observer: &dyn Observer,
 ) -> Result<SampledBoundaries> {
     use chatter_stability::StabilityError;
     use rayon::prelude::*;
@@ -308,7 +309,7 @@ pub fn sample_boundaries<S: StabilitySolver + ?Sized>(
                     (points, failures)
                 }
             };
-            progress(done.fetch_add(1, Ordering::Relaxed) + 1, thetas.len());
+            observer.steps_done(done.fetch_add(1, Ordering::Relaxed) + 1, thetas.len());
             row
         })
         .collect();
@@ -408,7 +409,7 @@ mod tests {
             &thetas,
             &speeds,
             &BoundaryOptions::default(),
-            &|_, _| {},
+            &chatter_progress::Silent,
         )
         .unwrap();
         // 1000 rpm: the lowered ones fail; 2000 rpm: the raised ones too

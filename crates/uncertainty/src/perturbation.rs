@@ -204,7 +204,7 @@ impl MomentGrid {
             BoundRule::ComplexSd => (&self.moments, 1.0),
             BoundRule::Coverage(c) => (
                 &self.modulus_moments,
-                chatter_updating::turning::normal_quantile(0.5 * (1.0 + c)),
+                chatter_bayes::special::normal_quantile(0.5 * (1.0 + c)),
             ),
         };
         self.speeds_rpm

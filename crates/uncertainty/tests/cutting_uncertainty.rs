@@ -35,7 +35,7 @@ fn a_kt_standard_deviation_alone_widens_the_band() {
         &thetas,
         &speeds,
         &BoundaryOptions::default(),
-        &|_, _| {},
+        &chatter_progress::Silent,
     )
     .unwrap();
     assert!(sampled.failures.is_empty());
@@ -80,7 +80,7 @@ fn depth_quantiles_follow_the_kt_quantiles_at_a_fixed_ratio() {
         &dist.draws(201, 0).unwrap(),
         &speeds,
         &options,
-        &|_, _| {},
+        &chatter_progress::Silent,
     )
     .unwrap();
     for (i, band) in sampled.depth_bands().iter().enumerate() {

@@ -33,7 +33,7 @@ fn map_of_the_turning_case_is_monotone_and_centred_on_the_mean_boundary() {
         &thetas,
         &speeds,
         &options,
-        &|_, _| {},
+        &chatter_progress::Silent,
     )
     .unwrap();
     let nominal = lobe_diagram(
@@ -41,7 +41,7 @@ fn map_of_the_turning_case_is_monotone_and_centred_on_the_mean_boundary() {
         &model,
         &speeds,
         &options,
-        &chatter_stability::boundary::Silent,
+        &chatter_progress::Silent,
     )
     .unwrap();
     let depths: Vec<f64> = (0..=80).map(|j| 0.1 * j as f64).collect();

@@ -7,11 +7,12 @@
 //! 003 cut likelihood on the process-damping flexure (cuts at 300, 700 and 1100 rpm) with each.
 
 use chatter_dynamics::Cut;
-use chatter_dynamics::{Milling, MillingDirection, Operation, examples};
+use chatter_dynamics::{Milling, MillingDirection, ModalModel, Operation, examples};
+use chatter_progress::Silent;
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::prepared::Method;
-use chatter_updating::boundary::{BoundaryOptions, limiting_depth};
-use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
+use chatter_stability::prepared::SolverOptions;
+use chatter_updating::classes::{Sampler, SamplerOptions, sample_posterior};
 use chatter_updating::cuts::{CutKernel, CutsLikelihood};
 use chatter_updating::milling::MillingPoleLikelihood;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
@@ -91,11 +92,14 @@ fn boundary(c: &mut Criterion) {
         .and_then(|op| bare.with_operation(Operation::Milling(op)))
         .and_then(|m| m.with_process_damping(Some(1e5)))
         .unwrap_or_else(|e| panic!("{e}"));
-    let zoa = BoundaryOptions {
-        method: Method::Zoa,
-        ..Default::default()
+    let zoa = SolverOptions::new(Method::Zoa);
+    let fdm = SolverOptions::default();
+    // prepared and queried per iteration, as a sampler does per sampled model
+    let limiting_depth = |model: &ModalModel, speed_rpm: f64, options: &SolverOptions| {
+        options
+            .prepare_on_grid_of(model, model)
+            .and_then(|solver| solver.limiting_depth(speed_rpm))
     };
-    let fdm = BoundaryOptions::default();
     let mut group = c.benchmark_group("boundary");
     group.sample_size(20);
     group.bench_function("limiting_depth_milling_2_modes", |b| {
@@ -138,11 +142,7 @@ fn cut_likelihood(c: &mut Criterion) {
     let mut group = c.benchmark_group("cut_likelihood_003");
     group.sample_size(20);
     for method in [Method::Zoa, Method::Fdm] {
-        let options = BoundaryOptions {
-            method,
-            max_depth_m: 7.5e-3,
-            ..Default::default()
-        };
+        let options = SolverOptions::new(method).with_max_depth_m(7.5e-3);
         let like = CutsLikelihood::new(p.clone(), cuts.clone(), CutKernel::karandikar(), options)
             .unwrap_or_else(|e| panic!("{e}"));
         group.bench_function(method.name(), |b| {

@@ -3,7 +3,8 @@
 //!
 //! `cargo run --release -p chatter-updating --example ahmadi2022 [SAMPLES] [ALPHA]`
 use chatter_dynamics::examples;
-use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
+use chatter_progress::Silent;
+use chatter_updating::classes::{Sampler, SamplerOptions, sample_posterior};
 use chatter_updating::defaults::turning_alphas;
 use chatter_updating::turning::{ResidualForm, TurningPoleLikelihood};
 use chatter_updating::update::{UpdateJob, UpdateSettings};

@@ -4,8 +4,9 @@
 //!
 //! `cargo run --release -p chatter-updating --example ebrahimi2025 [SAMPLES] [ALPHA]`
 use chatter_dynamics::examples;
+use chatter_progress::Silent;
 use chatter_stability::monodromy::Discretization;
-use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
+use chatter_updating::classes::{Sampler, SamplerOptions, sample_posterior};
 use chatter_updating::defaults::milling_alphas;
 use chatter_updating::milling::MillingPoleLikelihood;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};

@@ -7,7 +7,8 @@
 //!
 //! `cargo run --release -p chatter-updating --example ebrahimi2025_surrogate [SAMPLES] [ALPHA] [POINTS]`
 use chatter_dynamics::examples;
-use chatter_updating::classes::{Sampler, SamplerOptions, Silent};
+use chatter_progress::Silent;
+use chatter_updating::classes::{Sampler, SamplerOptions};
 use chatter_updating::update::{UpdateJob, UpdateSettings};
 use std::time::Instant;
 

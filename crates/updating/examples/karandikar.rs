@@ -18,7 +18,7 @@ use chatter_dynamics::{Cut, ModeShape, examples};
 use chatter_stability::boundary;
 use chatter_stability::monodromy::Discretization;
 use chatter_updating::cuts::CutKernel;
-use chatter_updating::ensemble::Silent;
+use chatter_progress::Silent;
 use chatter_updating::karandikar::{self, PAPER_PRIOR_P_STABLE, PAPER_PRIOR_SD_C};
 
 /// Tolerances of the issue: P_s within 0.1, expected reductions within 5 points.
@@ -109,16 +109,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "\nlimiting depth (mm) at the nominal kt, kn against C (0.5e5, 2.5e5, 5e5, 7.5e5, 10e5 N/m):"
     );
-    let options = chatter_updating::boundary::BoundaryOptions {
-        max_depth_m: karandikar::MAX_DEPTH_M,
-        ..Default::default()
-    };
+    let options = chatter_stability::prepared::SolverOptions::default()
+        .with_max_depth_m(karandikar::MAX_DEPTH_M);
     for speed in speeds {
         let limits = [0.5e5, 2.5e5, 5e5, 7.5e5, 10e5]
             .iter()
             .map(|&c| {
                 let m = model.with_process_damping(Some(c))?;
-                let p = chatter_updating::boundary::limiting_depth(&m, speed, &options)?;
+                let p = options.prepare_on_grid_of(&m, &m)?.limiting_depth(speed)?;
                 Ok(format!(
                     "{:5.2}",
                     p.depth_m.min(karandikar::MAX_DEPTH_M) * 1e3

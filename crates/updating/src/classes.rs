@@ -12,8 +12,9 @@ use crate::error::{Result, UpdatingError};
 use chatter_bayes::amcmc::{AmcmcOptions, adaptive_mcmc};
 use chatter_bayes::rejection::{LikelihoodBound, rejection_sample};
 use chatter_bayes::samples::SampleSet;
-use chatter_bayes::tmcmc::{SamplerObserver, TmcmcOptions, Variant, class_probabilities, tmcmc};
+use chatter_bayes::tmcmc::{TmcmcOptions, Variant, class_probabilities, tmcmc};
 use chatter_bayes::{LogLikelihood, Prior};
+use chatter_progress::Observer;
 
 /// Which posterior sampler.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -56,25 +57,12 @@ pub struct Posterior {
     pub numerical_failures: Option<usize>,
 }
 
-/// Progress of class selection; no-op by default. The sampler stages arrive through the
-/// [`SamplerObserver`] methods.
-pub trait ClassObserver: SamplerObserver {
-    /// Class `index` of `total` (alpha) starts.
-    fn class_started(&self, _index: usize, _total: usize, _alpha: f64) {}
-}
-
-/// The observer that does nothing.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Silent;
-impl SamplerObserver for Silent {}
-impl ClassObserver for Silent {}
-
 /// Sample the posterior p(theta | D) ∝ p(D | theta) p(theta).
 pub fn sample_posterior<P: Prior, L: LogLikelihood>(
     prior: &P,
     likelihood: &L,
     options: &SamplerOptions,
-    observer: &dyn SamplerObserver,
+    observer: &dyn Observer,
 ) -> Result<Posterior> {
     match options.sampler {
         Sampler::Itmcmc | Sampler::Tmcmc => {
@@ -176,7 +164,7 @@ pub fn select_model_class<P, L, F>(
     alphas: &[f64],
     likelihood: F,
     options: &SamplerOptions,
-    observer: &dyn ClassObserver,
+    observer: &dyn Observer,
 ) -> Result<ClassSelection>
 where
     P: Prior,
@@ -219,6 +207,7 @@ where
 mod tests {
     use super::*;
     use chatter_bayes::prior::{IndependentPrior, Marginal};
+    use chatter_progress::Silent;
 
     #[test]
     fn the_class_with_the_true_noise_ratio_wins() {

@@ -14,12 +14,12 @@
 //! (seed 003, Eq. 3 for a stable and Eq. 4 for an unstable result): l = 1 on the side of the path
 //! that agrees with the result and exp(-(b - b_test)^2 / k), k = 2 sigma^2, on the other.
 
-use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_bayes::LikelihoodFailure;
 use chatter_dynamics::Cut;
 use chatter_stability::boundary::LobePoint;
+use chatter_stability::prepared::SolverOptions;
 
 /// The kernel of a cut likelihood: allowed disagreement in depth and chatter frequency.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,7 +81,7 @@ impl CutKernel {
 
 /// The cut-result likelihood of a set of cuts as a function of the model parameters (for the
 /// samplers): the product of [`CutKernel::ln_likelihood`] over the cuts, each with the sampled
-/// model's boundary at its speed ([`crate::boundary`]: full discretization with process damping
+/// model's boundary at its speed ([`SolverOptions`]: full discretization with process damping
 /// by default, on the nominal model's grid).
 #[derive(Debug, Clone)]
 pub struct CutsLikelihood {
@@ -91,7 +91,7 @@ pub struct CutsLikelihood {
     speeds_rpm: Vec<f64>,
     speed_of: Vec<usize>,
     kernel: CutKernel,
-    options: BoundaryOptions,
+    options: SolverOptions,
 }
 
 impl CutsLikelihood {
@@ -100,7 +100,7 @@ impl CutsLikelihood {
         parameterization: Parameterization,
         cuts: Vec<Cut>,
         kernel: CutKernel,
-        options: BoundaryOptions,
+        options: SolverOptions,
     ) -> Result<Self> {
         if cuts.is_empty() {
             return Err(UpdatingError::Observations("no test cuts".into()));
@@ -153,7 +153,10 @@ impl CutsLikelihood {
             .model(theta)
             .map_err(|_| LikelihoodFailure::OutsideSupport)?;
         let grid = self.parameterization.nominal();
-        let boundaries = limiting_depths(&model, grid, &self.speeds_rpm, &self.options)
+        let boundaries = self
+            .options
+            .prepare_on_grid_of(&model, grid)
+            .and_then(|solver| solver.limiting_depths(&self.speeds_rpm))
             .map_err(|_| LikelihoodFailure::Numerical)?;
         Ok(self
             .cuts

@@ -4,7 +4,7 @@
 //!
 //! Each path i is a parameter sample theta_i (e.g. kt, kn and the process-damping coefficient C)
 //! drawn from the prior, with its limiting depth b_i(n) over a spindle-speed grid computed with
-//! [`crate::boundary`]. Before testing every path is equally likely, P_i = 1/n. A cut result a
+//! [`SolverOptions`]. Before testing every path is equally likely, P_i = 1/n. A cut result a
 //! multiplies P_i by its likelihood l_i (003 Eq. 3-4 or 004 Eq. 5, [`CutKernel`]) and the
 //! probabilities are renormalized (003 Eq. 2; 004 Eq. 6-7 with the prior ensemble standing in for
 //! the rejection-filtered samples). Posterior moments of a parameter follow 003 Eq. 5-6:
@@ -23,30 +23,21 @@
 //! grid depth with P_s >= P_test) the test is the point of maximum material removal rate; testing
 //! stops when the next test would improve the best stable MRR by less than 10 %.
 
-use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::classes::{Sampler, SamplerOptions, sample_posterior};
 use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_bayes::Prior;
 use chatter_bayes::samples::SampleSet;
+use chatter_bayes::special::normalized_weights;
 use chatter_dynamics::{Cut, ModalModel, Operation};
+use chatter_progress::{Observer, Silent};
 use chatter_stability::boundary::LobePoint;
+use chatter_stability::prepared::SolverOptions;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rayon::prelude::*;
 use std::f64::consts::PI;
-
-/// Progress of ensemble construction; no-op by default.
-pub trait EnsembleObserver: Sync {
-    /// `done` of `total` paths computed.
-    fn paths_done(&self, _done: usize, _total: usize) {}
-}
-
-/// The observer that does nothing.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Silent;
-impl EnsembleObserver for Silent {}
 
 /// A proposed test cut.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -105,7 +96,7 @@ pub struct BoundaryEnsemble {
     models: Vec<ModalModel>,
     columns: Vec<Column>,
     ln_weights: Vec<f64>,
-    options: BoundaryOptions,
+    options: SolverOptions,
 }
 
 /// A random stream per path, independent of the thread that computes it.
@@ -123,8 +114,8 @@ impl BoundaryEnsemble {
         parameterization: Parameterization,
         samples: Vec<Vec<f64>>,
         speeds_rpm: &[f64],
-        options: BoundaryOptions,
-        observer: &dyn EnsembleObserver,
+        options: SolverOptions,
+        observer: &dyn Observer,
     ) -> Result<Self> {
         if samples.is_empty() {
             return Err(UpdatingError::InvalidInput {
@@ -155,8 +146,8 @@ impl BoundaryEnsemble {
         parameterization: Parameterization,
         set: &SampleSet,
         speeds_rpm: &[f64],
-        options: BoundaryOptions,
-        observer: &dyn EnsembleObserver,
+        options: SolverOptions,
+        observer: &dyn Observer,
     ) -> Result<Self> {
         let mut ensemble = Self::from_samples(
             parameterization,
@@ -184,9 +175,9 @@ impl BoundaryEnsemble {
         kernel: &CutKernel,
         paths: usize,
         speeds_rpm: &[f64],
-        options: BoundaryOptions,
+        options: SolverOptions,
         seed: u64,
-        observer: &dyn EnsembleObserver,
+        observer: &dyn Observer,
     ) -> Result<Self> {
         if cuts.is_empty() {
             return Self::from_prior(
@@ -207,7 +198,7 @@ impl BoundaryEnsemble {
                 samples: paths,
                 seed,
             };
-            sample_posterior(prior, &likelihood, &settings, &crate::classes::Silent)
+            sample_posterior(prior, &likelihood, &settings, &chatter_progress::Silent)
         };
         let posterior = match draw(Sampler::Amcmc) {
             Err(UpdatingError::InvalidInput {
@@ -230,9 +221,9 @@ impl BoundaryEnsemble {
         prior: &P,
         paths: usize,
         speeds_rpm: &[f64],
-        options: BoundaryOptions,
+        options: SolverOptions,
         seed: u64,
-        observer: &dyn EnsembleObserver,
+        observer: &dyn Observer,
     ) -> Result<Self> {
         if prior.dimension() != parameterization.dimension() {
             return Err(UpdatingError::InvalidInput {
@@ -251,11 +242,7 @@ impl BoundaryEnsemble {
     }
 
     /// Compute the paths at more speeds (those already present are kept).
-    pub fn add_speeds(
-        &mut self,
-        speeds_rpm: &[f64],
-        observer: &dyn EnsembleObserver,
-    ) -> Result<()> {
+    pub fn add_speeds(&mut self, speeds_rpm: &[f64], observer: &dyn Observer) -> Result<()> {
         let mut new: Vec<f64> = speeds_rpm
             .iter()
             .copied()
@@ -273,9 +260,13 @@ impl BoundaryEnsemble {
             .models
             .par_iter()
             .map(|m| {
-                let row = limiting_depths(m, grid, &new, &self.options);
+                let row = self
+                    .options
+                    .prepare_on_grid_of(m, grid)
+                    .and_then(|solver| solver.limiting_depths(&new))
+                    .map_err(UpdatingError::from);
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                observer.paths_done(k, total);
+                observer.steps_done(k, total);
                 row
             })
             .collect::<Result<Vec<_>>>()?;
@@ -330,7 +321,7 @@ impl BoundaryEnsemble {
 
     /// Path probabilities P_i (sum 1).
     pub fn probabilities(&self) -> Vec<f64> {
-        normalized(&self.ln_weights)
+        normalized_weights(&self.ln_weights)
     }
 
     /// Kish effective number of paths, (sum P)^2 / sum P^2.
@@ -576,14 +567,6 @@ fn contour_depth(p: &[f64], column: &Column, p_test: f64) -> Option<f64> {
     None
 }
 
-/// exp of max-shifted log weights, normalized.
-fn normalized(ln_w: &[f64]) -> Vec<f64> {
-    let m = ln_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let w: Vec<f64> = ln_w.iter().map(|x| (x - m).exp()).collect();
-    let s: f64 = w.iter().sum();
-    w.iter().map(|x| x / s).collect()
-}
-
 fn stable_probability(p: &[f64], column: &Column, depth_m: f64) -> f64 {
     p.iter()
         .zip(&column.points)
@@ -614,7 +597,7 @@ mod tests {
             &prior,
             40,
             &[2100.0, 2400.0],
-            BoundaryOptions::default(),
+            SolverOptions::default(),
             3,
             &Silent,
         )

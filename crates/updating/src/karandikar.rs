@@ -14,9 +14,10 @@
 //! RSS(C) = sum over speeds (b_exp - b_lim(C))^2, b_lim the process-damped limiting depth
 //! ([`crate::boundary`]) capped at the tool's cutting-edge length.
 
-use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::cuts::CutKernel;
-use crate::ensemble::{BoundaryEnsemble, EnsembleObserver};
+use crate::ensemble::BoundaryEnsemble;
+use chatter_progress::Observer;
+use chatter_stability::prepared::SolverOptions;
 use crate::error::{Result, UpdatingError};
 use crate::parameters::{ModelParameter, Parameterization};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
@@ -116,14 +117,11 @@ pub fn prior_paths(
     paths: usize,
     speeds_rpm: &[f64],
     seed: u64,
-    observer: &dyn EnsembleObserver,
+    observer: &dyn Observer,
 ) -> Result<BoundaryEnsemble> {
     let (parameters, prior) = prior()?;
     let p = Parameterization::new(model.clone(), parameters)?;
-    let options = BoundaryOptions {
-        max_depth_m: MAX_DEPTH_M,
-        ..Default::default()
-    };
+    let options = SolverOptions::default().with_max_depth_m(MAX_DEPTH_M);
     BoundaryEnsemble::from_prior(p, &prior, paths, speeds_rpm, options, seed, observer)
 }
 
@@ -228,13 +226,12 @@ pub fn rss_process_damping(
         });
     }
     let speeds: Vec<f64> = limits.iter().map(|l| l.speed_rpm).collect();
-    let options = BoundaryOptions {
-        max_depth_m: MAX_DEPTH_M,
-        ..Default::default()
-    };
+    let options = SolverOptions::default().with_max_depth_m(MAX_DEPTH_M);
     let rss = |c: f64| -> Result<f64> {
         let m = model.with_process_damping(Some(c))?;
-        let points = limiting_depths(&m, model, &speeds, &options)?;
+        let points = options
+            .prepare_on_grid_of(&m, model)?
+            .limiting_depths(&speeds)?;
         Ok(points
             .iter()
             .zip(&limits)

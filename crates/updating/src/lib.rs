@@ -8,7 +8,6 @@
 //! | [`milling`] | identified Floquet multipliers (frequency, damping) against the exact discretized monodromy operator, sigma_zeta = alpha sigma_w | 002 Eq. 13-15 |
 //! | [`cuts`] | stable / chatter results with chatter frequency; the one-sided kernel | 004 Eq. 5, 003 Eq. 3-4 |
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
-//! | [`boundary`] | limiting depths of sampled models: full discretization with process damping, prepared per model, on the nominal grid | 000 Eq. 9-11, 003 Eq. 1 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
 //! | [`karandikar`] | 003's prior, Table 2's candidate tests with the paper's numbers, RSS identification of C | 003 |
 //! | [`surrogate`] | Matérn GP surrogate of the dominant milling multiplier, with its error against the exact one | 002 Section 2.2 |
@@ -20,7 +19,8 @@
 //!
 //! ```
 //! use chatter_dynamics::examples;
-//! use chatter_updating::classes::{Sampler, SamplerOptions, Silent};
+//! use chatter_updating::classes::{Sampler, SamplerOptions};
+//! use chatter_progress::Silent;
 //! use chatter_updating::update::{UpdateJob, UpdateSettings};
 //! let settings = UpdateSettings { classes: Some(vec![1.0]), ..Default::default() };
 //! let job = UpdateJob::new(
@@ -38,7 +38,6 @@
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
-pub mod boundary;
 pub mod classes;
 pub mod cuts;
 pub mod defaults;

@@ -3,17 +3,16 @@
 //! maximum material removal rate (004: paths drawn from the posterior by rejection sampling and
 //! parallel adaptive MCMC), with the papers' stopping rules.
 
-use crate::boundary::{BoundaryOptions, limiting_depths};
 use crate::cuts::CutKernel;
 use crate::defaults::{default_parameters, parameter_prior};
-use crate::ensemble::{
-    BoundaryEnsemble, EnsembleObserver, TestPlan, material_removal_rate_cm3_per_min,
-};
+use crate::ensemble::{BoundaryEnsemble, TestPlan, material_removal_rate_cm3_per_min};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::update::PriorOverrides;
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_progress::Observer;
+use chatter_stability::prepared::SolverOptions;
 
 /// How the next test is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -127,7 +126,9 @@ fn grid_default(model: &ModalModel, observations: &Observations) -> Result<(Vec<
             range.first().copied().unwrap_or(hi / 10.0)
         };
         let speeds = spread(lo, hi);
-        let nominal = limiting_depths(model, model, &speeds, &BoundaryOptions::default())?;
+        let nominal = SolverOptions::default()
+            .prepare_on_grid_of(model, model)?
+            .limiting_depths(&speeds)?;
         let deepest = nominal
             .iter()
             .map(|p| p.depth_m)
@@ -160,7 +161,7 @@ pub fn plan_next_cut(
     model: &ModalModel,
     observations: &Observations,
     settings: &PlanSettings,
-    observer: &dyn EnsembleObserver,
+    observer: &dyn Observer,
 ) -> Result<PlanOutcome> {
     if !(settings.feed_per_tooth_m.is_finite() && settings.feed_per_tooth_m > 0.0) {
         return Err(UpdatingError::InvalidInput {
@@ -199,10 +200,7 @@ pub fn plan_next_cut(
         }
     };
     let max_depth = depths.iter().copied().fold(0.0, f64::max);
-    let options = BoundaryOptions {
-        max_depth_m: (2.0 * max_depth).max(1e-3),
-        ..Default::default()
-    };
+    let options = SolverOptions::default().with_max_depth_m((2.0 * max_depth).max(1e-3));
     let kernel = settings
         .kernel
         .unwrap_or(match settings.strategy {
@@ -326,8 +324,8 @@ pub fn plan_next_cut(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ensemble::Silent;
     use chatter_dynamics::examples;
+    use chatter_progress::Silent;
 
     #[test]
     fn both_strategies_propose_a_cut_on_the_grid() {

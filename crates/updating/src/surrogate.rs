@@ -315,7 +315,7 @@ pub fn refined_for_class(
     for _ in 0..REFINEMENTS {
         let like = likelihood.clone().with_surrogate(current.clone());
         let pilot =
-            crate::classes::sample_posterior(prior, &like, &options, &crate::classes::Silent)?;
+            crate::classes::sample_posterior(prior, &like, &options, &chatter_progress::Silent)?;
         let boxes: Vec<(f64, f64)> = (0..d)
             .map(|k| {
                 let (lo, hi) = pilot

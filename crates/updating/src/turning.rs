@@ -6,7 +6,8 @@
 //!
 //! det D(lambda) = 0, D(lambda) = lambda^2 I + 2 Omega Z lambda + Omega^2 + a Phi^T K_c Phi (1 - e^{-lambda tau}),
 //!
-//! with Omega, Z, Phi functions of theta. Two residuals are available ([`ResidualForm`]):
+//! ([`chatter_stability::characteristic`], which adds the model's process damping when it has
+//! one) with Omega, Z, Phi functions of theta. Two residuals are available ([`ResidualForm`]):
 //!
 //! - [`ResidualForm::Determinant`]: Eq. 28 as printed, e_R + i e_I = det D(lambda_hat);
 //! - [`ResidualForm::PoleError`] (default): e_R + i e_I = lambda_hat - lambda*, with lambda* the
@@ -43,9 +44,10 @@
 use crate::error::{Result, UpdatingError};
 use crate::parameters::Parameterization;
 use chatter_bayes::LikelihoodFailure;
+use chatter_bayes::special::normal_quantile;
 use chatter_dynamics::pole::pole_from_frequency_damping;
 use chatter_dynamics::{ModalModel, Operation, PoleObservation};
-use nalgebra::DMatrix;
+use chatter_stability::characteristic::Characteristic;
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -116,137 +118,16 @@ pub fn expand_repetitions(poles: &[PoleObservation]) -> Vec<ObservedPole> {
     out
 }
 
-/// Inverse standard normal CDF (Acklam's rational approximation, relative error < 1.2e-9).
-pub fn normal_quantile(p: f64) -> f64 {
-    const A: [f64; 6] = [
-        -3.969_683_028_665_376e1,
-        2.209_460_984_245_205e2,
-        -2.759_285_104_469_687e2,
-        1.383_577_518_672_69e2,
-        -3.066_479_806_614_716e1,
-        2.506_628_277_459_239,
-    ];
-    const B: [f64; 5] = [
-        -5.447_609_879_822_406e1,
-        1.615_858_368_580_409e2,
-        -1.556_989_798_598_866e2,
-        6.680_131_188_771_972e1,
-        -1.328_068_155_288_572e1,
-    ];
-    const C: [f64; 6] = [
-        -7.784_894_002_430_293e-3,
-        -3.223_964_580_411_365e-1,
-        -2.400_758_277_161_838,
-        -2.549_732_539_343_734,
-        4.374_664_141_464_968,
-        2.938_163_982_698_783,
-    ];
-    const D: [f64; 4] = [
-        7.784_695_709_041_462e-3,
-        3.224_671_290_700_398e-1,
-        2.445_134_137_142_996,
-        3.754_408_661_907_416,
-    ];
-    let p = p.clamp(1e-300, 1.0 - 1e-16);
-    let tail = |q: f64| {
-        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
-            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
-    };
-    if p < 0.02425 {
-        tail((-2.0 * p.ln()).sqrt())
-    } else if p > 1.0 - 0.02425 {
-        -tail((-2.0 * (1.0 - p).ln()).sqrt())
-    } else {
-        let q = p - 0.5;
-        let r = q * q;
-        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
-            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
-    }
-}
-
 /// The characteristic-equation residual det(D(lambda)) of a turning model (Eq. 28).
-pub fn characteristic_residual(model: &ModalModel, pole: &ObservedPole) -> Complex64 {
-    let tau = model.operation().delay_s(pole.speed_rpm);
-    Characteristic::new(model).determinant(pole.lambda, pole.depth_m, tau)
+pub fn characteristic_residual(model: &ModalModel, pole: &ObservedPole) -> Result<Complex64> {
+    Ok(Characteristic::new(model, pole.speed_rpm)?.determinant(pole.lambda, pole.depth_m))
 }
 
-/// Newton iterations of the root search and their relative tolerance on lambda.
+/// Newton iterations of the root search.
 const NEWTON_ITERATIONS: usize = 60;
-const NEWTON_TOL: f64 = 1e-12;
 /// A root farther than this fraction of |lambda_hat| from the identified pole is not the
 /// identified branch (the likelihood is then zero).
 const MAX_ROOT_DISTANCE: f64 = 0.2;
-
-/// The terms of D(lambda) that do not depend on the cutting condition.
-struct Characteristic {
-    omegas: Vec<f64>,
-    zetas: Vec<f64>,
-    /// Phi^T K_c Phi (N x N, per unit width).
-    coupling: DMatrix<f64>,
-}
-
-impl Characteristic {
-    fn new(model: &ModalModel) -> Self {
-        let phi = model.shape_matrix();
-        let h = model.directional_matrix(0.0, 0.0);
-        let hm = DMatrix::from_fn(2, 2, |i, j| h[(i, j)]);
-        Self {
-            omegas: model.omegas_rad_s(),
-            zetas: model.damping_ratios(),
-            coupling: phi.transpose() * hm * &phi,
-        }
-    }
-
-    fn matrix(&self, lambda: Complex64, a: f64, tau: f64) -> DMatrix<Complex64> {
-        let regen = Complex64::new(1.0, 0.0) - (-lambda * tau).exp();
-        let n = self.omegas.len();
-        DMatrix::from_fn(n, n, |i, j| {
-            let mut v = regen * (a * self.coupling[(i, j)]);
-            if i == j {
-                let w = self.omegas[i];
-                v += lambda * lambda + 2.0 * self.zetas[i] * w * lambda + w * w;
-            }
-            v
-        })
-    }
-
-    fn determinant(&self, lambda: Complex64, a: f64, tau: f64) -> Complex64 {
-        self.matrix(lambda, a, tau).determinant()
-    }
-
-    /// The Newton step det D / (d det D / d lambda) = 1 / tr(D^-1 D').
-    fn newton_step(&self, lambda: Complex64, a: f64, tau: f64) -> Option<Complex64> {
-        let d = self.matrix(lambda, a, tau);
-        let delay = (-lambda * tau).exp() * (a * tau);
-        let n = self.omegas.len();
-        let dd = DMatrix::from_fn(n, n, |i, j| {
-            let mut v = delay * self.coupling[(i, j)];
-            if i == j {
-                v += 2.0 * lambda + 2.0 * self.zetas[i] * self.omegas[i];
-            }
-            v
-        });
-        let x = d.lu().solve(&dd)?;
-        let trace = x.trace();
-        (trace.norm() > 0.0 && trace.is_finite()).then(|| trace.inv())
-    }
-
-    /// The root of det D(lambda) at (a, tau) reached by Newton's method from `start`.
-    fn root(&self, start: Complex64, a: f64, tau: f64) -> Option<Complex64> {
-        let mut lambda = start;
-        for _ in 0..NEWTON_ITERATIONS {
-            let step = self.newton_step(lambda, a, tau)?;
-            lambda -= step;
-            if !lambda.is_finite() || (lambda - start).norm() > MAX_ROOT_DISTANCE * start.norm() {
-                return None;
-            }
-            if step.norm() <= NEWTON_TOL * lambda.norm() {
-                return Some(lambda);
-            }
-        }
-        None
-    }
-}
 
 /// Which residual enters Eq. 29-31 (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -263,7 +144,6 @@ pub enum ResidualForm {
 struct Condition {
     speed_rpm: f64,
     depth_m: f64,
-    tau_s: f64,
     /// Mean of the identified poles: the start of the root search.
     start: Complex64,
 }
@@ -324,7 +204,6 @@ impl TurningPoleLikelihood {
                 conditions.push(Condition {
                     speed_rpm: p.speed_rpm,
                     depth_m: p.depth_m,
-                    tau_s: parameterization.nominal().operation().delay_s(p.speed_rpm),
                     start: Complex64::new(0.0, 0.0),
                 });
                 counts.push(0.0);
@@ -382,12 +261,13 @@ impl TurningPoleLikelihood {
     /// The roots lambda* of the characteristic equation nearest to the identified poles, one per
     /// cutting condition (speed_rpm, depth_m, lambda*), at the model parameters `theta_m`.
     pub fn predicted_poles(&self, theta_m: &[f64]) -> Result<Vec<(f64, f64, Complex64)>> {
-        let ch = Characteristic::new(&self.parameterization.model(theta_m)?);
+        let model = self.parameterization.model(theta_m)?;
         self.conditions
             .iter()
             .map(|c| {
-                let root = ch.root(c.start, c.depth_m, c.tau_s).ok_or_else(|| {
-                    UpdatingError::InvalidInput {
+                let root = Characteristic::new(&model, c.speed_rpm)?
+                    .newton_within(c.start, c.depth_m, NEWTON_ITERATIONS, MAX_ROOT_DISTANCE)
+                    .ok_or_else(|| UpdatingError::InvalidInput {
                         field: "theta",
                         message: format!(
                             "no root of the characteristic equation near the poles identified at \
@@ -395,8 +275,7 @@ impl TurningPoleLikelihood {
                             c.speed_rpm,
                             c.depth_m * 1e3
                         ),
-                    }
-                })?;
+                    })?;
                 Ok((c.speed_rpm, c.depth_m, root))
             })
             .collect()
@@ -415,12 +294,17 @@ impl TurningPoleLikelihood {
                     .collect())
             }
             ResidualForm::Determinant => {
-                let ch = Characteristic::new(&self.parameterization.model(theta_m)?);
+                let model = self.parameterization.model(theta_m)?;
+                let equations = self
+                    .conditions
+                    .iter()
+                    .map(|c| Characteristic::new(&model, c.speed_rpm))
+                    .collect::<chatter_stability::Result<Vec<_>>>()?;
                 Ok(self
                     .poles
                     .iter()
                     .zip(&self.condition_of)
-                    .map(|(p, &k)| ch.determinant(p.lambda, p.depth_m, self.conditions[k].tau_s))
+                    .map(|(p, &k)| equations[k].determinant(p.lambda, p.depth_m))
                     .collect())
             }
         }
@@ -515,7 +399,7 @@ mod tests {
                 depth_m: 0.0,
                 lambda: Complex64::new(-z * w, w * (1.0 - z * z).sqrt()),
             };
-            let e = characteristic_residual(&model, &pole);
+            let e = characteristic_residual(&model, &pole).unwrap();
             // det scale ~ w^4; a root leaves only rounding
             assert!(e.norm() < 1e-6 * w.powi(4), "{e}");
         }
@@ -531,13 +415,6 @@ mod tests {
         let sd = (f.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 9.0).sqrt();
         assert!((mean - 2473.0).abs() < 1e-3, "{mean}");
         assert!((sd - 0.56).abs() < 0.01, "{sd}");
-    }
-
-    #[test]
-    fn normal_quantile_matches_known_values() {
-        assert!(normal_quantile(0.5).abs() < 1e-12);
-        assert!((normal_quantile(0.975) - 1.959_963_984_540_054).abs() < 1e-8);
-        assert!((normal_quantile(0.001) + 3.090_232_306_167_813).abs() < 1e-8);
     }
 
     #[test]
@@ -576,12 +453,13 @@ mod tests {
     fn pole_error_is_the_newton_step_of_the_determinant() {
         // near a root, det D / det D' equals lambda_hat - lambda* to first order
         let model = examples::ahmadi_2022_turning();
-        let ch = Characteristic::new(&model);
-        let tau = model.operation().delay_s(7150.0);
+        let ch = Characteristic::new(&model, 7150.0).unwrap();
         let start = ObservedPole::from_frequency_damping(7150.0, 2.286e-3, 2473.0, 0.0012).lambda;
-        let root = ch.root(start, 2.286e-3, tau).unwrap();
+        let root = ch
+            .newton_within(start, 2.286e-3, NEWTON_ITERATIONS, MAX_ROOT_DISTANCE)
+            .unwrap();
         let near = root + Complex64::new(0.05, 0.3);
-        let step = ch.newton_step(near, 2.286e-3, tau).unwrap();
+        let step = ch.newton_step(near, 2.286e-3).unwrap();
         assert!((step - (near - root)).norm() < 1e-3 * (near - root).norm());
     }
 }

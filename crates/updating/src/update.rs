@@ -8,8 +8,7 @@
 //! s_S = 0.125 mm and s_fc = 50 Hz) as a single class.
 //! Parameters, priors and classes default to the papers' ([`crate::defaults`]).
 
-use crate::boundary::BoundaryOptions;
-use crate::classes::{ClassObserver, SamplerOptions, sample_posterior, select_model_class};
+use crate::classes::{SamplerOptions, sample_posterior, select_model_class};
 use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::defaults::{
     MILLING_ERROR_VARIANCE, TURNING_ERROR_VARIANCE, default_parameters, error_variance_prior,
@@ -22,7 +21,9 @@ use crate::turning::{ResidualForm, TurningPoleLikelihood, expand_repetitions};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_bayes::samples::SampleSet;
 use chatter_dynamics::{Cut, ModalModel, Observations, Operation, PoleObservation};
+use chatter_progress::Observer;
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::prepared::SolverOptions;
 use nalgebra::DMatrix;
 use std::collections::BTreeMap;
 
@@ -267,11 +268,7 @@ impl UpdateJob {
     }
 
     /// Sample every class and summarize the selected one.
-    pub fn run(
-        &self,
-        options: &SamplerOptions,
-        observer: &dyn ClassObserver,
-    ) -> Result<UpdateResult> {
+    pub fn run(&self, options: &SamplerOptions, observer: &dyn Observer) -> Result<UpdateResult> {
         let p = &self.parameterization;
         let mut surrogate = None;
         let (samples, classes, selected_alpha) = match &self.data {
@@ -281,7 +278,7 @@ impl UpdateJob {
                     p.clone(),
                     cuts.clone(),
                     CutKernel::schmitz(),
-                    BoundaryOptions::default(),
+                    SolverOptions::default(),
                 )?;
                 let post = sample_posterior(&self.prior, &like, options, observer)?;
                 let class = ClassSummary {
@@ -413,7 +410,7 @@ impl UpdateJob {
                         p.clone(),
                         vec![c.clone()],
                         CutKernel::schmitz(),
-                        BoundaryOptions::default(),
+                        SolverOptions::default(),
                     )
                     .map(|l| Box::new(l) as Box<dyn LogLikelihood>)
                 })
@@ -573,8 +570,9 @@ fn summarize(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classes::{Sampler, Silent};
+    use crate::classes::Sampler;
     use chatter_dynamics::examples;
+    use chatter_progress::Silent;
 
     #[test]
     fn pointwise_log_likelihood_sums_to_the_likelihood_of_all_poles() {
@@ -682,7 +680,9 @@ mod tests {
                 .unwrap()
                 .model(&[kn])
                 .unwrap();
-            crate::boundary::limiting_depth(&m, 2100.0, &BoundaryOptions::default())
+            SolverOptions::default()
+                .prepare_on_grid_of(&m, &m)
+                .and_then(|solver| solver.limiting_depth(2100.0))
                 .unwrap()
                 .depth_m
         };

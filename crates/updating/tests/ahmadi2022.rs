@@ -9,9 +9,10 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::examples;
+use chatter_progress::Silent;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::frequency_domain::{FrequencyDomain, dominant_pole};
-use chatter_updating::classes::{Sampler, SamplerOptions, Silent};
+use chatter_updating::classes::{Sampler, SamplerOptions};
 use chatter_updating::update::{UpdateJob, UpdateSettings};
 
 #[test]

@@ -11,8 +11,9 @@ use chatter_dynamics::{
     CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
     PoleObservation,
 };
+use chatter_progress::Silent;
 use chatter_stability::monodromy::Discretization;
-use chatter_updating::classes::{Sampler, SamplerOptions, Silent, sample_posterior};
+use chatter_updating::classes::{Sampler, SamplerOptions, sample_posterior};
 use chatter_updating::milling::MillingPoleLikelihood;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
 

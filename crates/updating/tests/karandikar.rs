@@ -18,12 +18,13 @@
 
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{Cut, ModalModel, examples};
+use chatter_progress::Silent;
 use chatter_stability::boundary;
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::prepared::Method;
-use chatter_updating::boundary::BoundaryOptions;
+use chatter_stability::prepared::SolverOptions;
 use chatter_updating::cuts::CutKernel;
-use chatter_updating::ensemble::{BoundaryEnsemble, Silent};
+use chatter_updating::ensemble::BoundaryEnsemble;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
 use std::collections::BTreeMap;
 
@@ -95,11 +96,7 @@ fn prior_paths(speeds: &[f64], method: Method) -> BoundaryEnsemble {
         },
     ])
     .unwrap();
-    let options = BoundaryOptions {
-        method,
-        max_depth_m: 7.5e-3,
-        ..Default::default()
-    };
+    let options = SolverOptions::new(method).with_max_depth_m(7.5e-3);
     BoundaryEnsemble::from_prior(p, &prior, PATHS, speeds, options, 11, &Silent).unwrap()
 }
 

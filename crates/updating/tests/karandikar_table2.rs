@@ -8,7 +8,7 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::examples;
-use chatter_updating::ensemble::Silent;
+use chatter_progress::Silent;
 use chatter_updating::karandikar;
 
 #[test]

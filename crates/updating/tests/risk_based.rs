@@ -15,12 +15,13 @@ use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{
     Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
 };
-use chatter_stability::boundary::{self, BoundaryOptions as SearchOptions};
+use chatter_progress::Silent;
+use chatter_stability::boundary::BoundaryOptions as SearchOptions;
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::prepared::SolverOptions;
 use chatter_stability::prepared::{PreparedDiscretization, PreparedSolver};
-use chatter_updating::boundary::BoundaryOptions;
 use chatter_updating::cuts::CutKernel;
-use chatter_updating::ensemble::{BoundaryEnsemble, Silent, material_removal_rate_cm3_per_min};
+use chatter_updating::ensemble::{BoundaryEnsemble, material_removal_rate_cm3_per_min};
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
 
 /// A 3-flute 12.7 mm endmill at 75 % radial immersion (004), two tool modes.
@@ -66,7 +67,7 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
         &SearchOptions::default(),
     )
     .unwrap()
-    .lobes(&speeds, &boundary::Silent)
+    .lobes(&speeds, &chatter_progress::Silent)
     .unwrap();
     let feed = 0.1e-3;
     let mrr = |s: f64, d: f64| material_removal_rate_cm3_per_min(&truth, s, d, feed).unwrap();
@@ -101,10 +102,7 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
         },
     ])
     .unwrap();
-    let options = BoundaryOptions {
-        max_depth_m: 10e-3,
-        ..Default::default()
-    };
+    let options = SolverOptions::default().with_max_depth_m(10e-3);
     let mut samples =
         BoundaryEnsemble::from_prior(p.clone(), &prior, PATHS, &speeds, options, 5, &Silent)
             .unwrap();

@@ -11,10 +11,12 @@
 //! interpolant. Lobes exist only for chatter frequencies inside the measured band: a speed whose
 //! lobes all fall outside it counts as stable (infinite depth).
 
-use super::ZeroOrderOptions;
 use super::system::{EigenPair, principal_sqrt};
+use super::{ZeroOrderOptions, multipliers_unsupported};
 use crate::boundary::LobePoint;
 use crate::error::{Result, check_condition};
+use crate::multiplier::DominantMultiplier;
+use crate::prepared::PreparedSolver;
 use chatter_dynamics::cutting::average_directional_matrix;
 use chatter_dynamics::{CuttingCoefficients, Operation, ReceptanceMatrix, SampledReceptance};
 use num_complex::Complex64;
@@ -24,7 +26,7 @@ use std::f64::consts::PI;
 const BISECTION_STEPS: usize = 48;
 
 /// The oriented measured FRF: the eigenvalue branches of A_0 G(i w) at the measured
-/// frequencies, prepared once per model; [`Self::limiting_depth`] then costs one pass over the
+/// frequencies, prepared once per model; [`Self::shallowest_crossing`] then costs one pass over the
 /// frequencies per speed.
 #[derive(Debug, Clone)]
 pub struct MeasuredLobeTable {
@@ -190,18 +192,75 @@ impl MeasuredLobeTable {
         last
     }
 
-    /// The limiting depth at delay `tau_s`: the shallowest crossing as (depth m, chatter Hz), or
-    /// None when no lobe crosses inside the measured band.
-    pub fn limiting_depth(&self, tau_s: f64) -> Option<(f64, f64)> {
+    /// The shallowest crossing at delay `tau_s` as (depth m, chatter Hz), or None when no lobe
+    /// crosses inside the measured band.
+    pub fn shallowest_crossing(&self, tau_s: f64) -> Option<(f64, f64)> {
         self.crossings(tau_s)
             .into_iter()
             .min_by(|x, y| x.0.total_cmp(&y.0))
     }
 }
 
+/// The zero-order method prepared for a measured receptance (no modal model, no process
+/// damping): its [`MeasuredLobeTable`] under one operation, queried at any speed. Like
+/// [`super::PreparedZeroOrder`] it gives limiting depths only.
+#[derive(Debug, Clone)]
+pub struct PreparedMeasured {
+    operation: Operation,
+    table: MeasuredLobeTable,
+    options: ZeroOrderOptions,
+}
+
+impl PreparedMeasured {
+    /// Tabulate `receptance` under the averaged cutting forces of `operation` and `cutting`.
+    pub fn new(
+        operation: &Operation,
+        cutting: CuttingCoefficients,
+        receptance: &SampledReceptance,
+        options: &ZeroOrderOptions,
+    ) -> Result<Self> {
+        options.validate()?;
+        Ok(Self {
+            operation: operation.clone(),
+            table: MeasuredLobeTable::new(operation, cutting, receptance.clone()),
+            options: *options,
+        })
+    }
+}
+
+impl PreparedSolver for PreparedMeasured {
+    fn name(&self) -> &'static str {
+        "zoa-measured"
+    }
+
+    fn dominant_multiplier(&self, _speed_rpm: f64, _depth_m: f64) -> Result<DominantMultiplier> {
+        Err(multipliers_unsupported(self.name()))
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        _speed_rpm: f64,
+        _depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        Err(multipliers_unsupported(self.name()))
+    }
+
+    /// The shallowest crossing at `speed_rpm`; infinite where no lobe crosses inside the
+    /// measured band below the options' depth ceiling.
+    fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
+        check_condition(speed_rpm, 0.0)?;
+        Ok(LobePoint::below_ceiling(
+            speed_rpm,
+            self.table
+                .shallowest_crossing(self.operation.delay_s(speed_rpm)),
+            self.options.max_depth_m,
+        ))
+    }
+}
+
 /// Zero-order limiting depths at `speeds_rpm` from a measured receptance (no process damping):
 /// `depth_m` is infinite where no lobe crosses inside the measured band below
-/// `options.max_depth_m`.
+/// `options.max_depth_m` ([`PreparedMeasured`]).
 pub fn measured_limiting_depths(
     operation: &Operation,
     cutting: CuttingCoefficients,
@@ -213,24 +272,7 @@ pub fn measured_limiting_depths(
     for &s in speeds_rpm {
         check_condition(s, 0.0)?;
     }
-    let table = MeasuredLobeTable::new(operation, cutting, receptance.clone());
-    Ok(speeds_rpm
-        .iter()
-        .map(
-            |&speed_rpm| match table.limiting_depth(operation.delay_s(speed_rpm)) {
-                Some((depth_m, chatter_hz)) if depth_m <= options.max_depth_m => LobePoint {
-                    speed_rpm,
-                    depth_m,
-                    chatter_hz,
-                },
-                _ => LobePoint {
-                    speed_rpm,
-                    depth_m: f64::INFINITY,
-                    chatter_hz: f64::NAN,
-                },
-            },
-        )
-        .collect())
+    PreparedMeasured::new(operation, cutting, receptance, options)?.limiting_depths(speeds_rpm)
 }
 
 #[cfg(test)]

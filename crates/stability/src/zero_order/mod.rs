@@ -38,12 +38,14 @@ mod system;
 mod table;
 
 pub use damped::ProcessDampedTable;
-pub use measured::{MeasuredLobeTable, measured_limiting_depths};
+pub use measured::{MeasuredLobeTable, PreparedMeasured, measured_limiting_depths};
 pub use system::{ModalTerm, OrientedSystem};
 pub use table::LobeTable;
 
 use crate::boundary::LobePoint;
-use crate::error::{Result, check_condition, invalid};
+use crate::error::{Result, StabilityError, check_condition, invalid};
+use crate::multiplier::DominantMultiplier;
+use crate::prepared::PreparedSolver;
 use crate::process_damping::damping_ratio_slopes_per_cv;
 use chatter_dynamics::ModalModel;
 
@@ -136,10 +138,30 @@ impl PreparedZeroOrder {
     pub fn model(&self) -> &ModalModel {
         &self.model
     }
+}
 
-    /// The limiting depth at `speed_rpm`; infinite where the cut is stable up to the options'
+/// The zero-order method's one query: the limiting depth; its multiplier queries are a typed
+/// [`StabilityError::Unsupported`].
+impl PreparedSolver for PreparedZeroOrder {
+    fn name(&self) -> &'static str {
+        "zoa"
+    }
+
+    fn dominant_multiplier(&self, _speed_rpm: f64, _depth_m: f64) -> Result<DominantMultiplier> {
+        Err(multipliers_unsupported("zoa"))
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        _speed_rpm: f64,
+        _depth_m: f64,
+    ) -> Result<(DominantMultiplier, f64)> {
+        Err(multipliers_unsupported("zoa"))
+    }
+
+    /// The shallowest lobe at `speed_rpm`; infinite where the cut is stable up to the options'
     /// depth ceiling.
-    pub fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
+    fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
         check_condition(speed_rpm, 0.0)?;
         let tau = self.model.operation().delay_s(speed_rpm);
         let lobes = match &self.tables {
@@ -148,24 +170,26 @@ impl PreparedZeroOrder {
             }
             Tables::Bare(t) => t.lobes(tau, 1)?,
         };
-        Ok(match lobes.first() {
-            Some(l) if l.depth_m <= self.options.max_depth_m => LobePoint {
-                speed_rpm,
-                depth_m: l.depth_m,
-                chatter_hz: l.chatter_hz,
-            },
-            _ => LobePoint {
-                speed_rpm,
-                depth_m: f64::INFINITY,
-                chatter_hz: f64::NAN,
-            },
-        })
+        Ok(LobePoint::below_ceiling(
+            speed_rpm,
+            lobes.first().map(|l| (l.depth_m, l.chatter_hz)),
+            self.options.max_depth_m,
+        ))
+    }
+}
+
+/// The error of a multiplier query to a zero-order solver (`method`).
+fn multipliers_unsupported(method: &'static str) -> StabilityError {
+    StabilityError::Unsupported {
+        method,
+        reason: "the zero-order method gives limiting depths, not multipliers; use fdm or sdm"
+            .into(),
     }
 }
 
 /// Zero-order limiting depths at `speeds_rpm`, with the model's process damping (003) when it
 /// has one; `depth_m` is infinite where the cut is stable up to `options.max_depth_m`. One
-/// [`PreparedZeroOrder`] serves every speed.
+/// [`PreparedZeroOrder`] serves every speed ([`PreparedSolver::limiting_depths`]).
 pub fn limiting_depths(
     model: &ModalModel,
     speeds_rpm: &[f64],
@@ -175,23 +199,7 @@ pub fn limiting_depths(
     for &s in speeds_rpm {
         check_condition(s, 0.0)?;
     }
-    let prepared = PreparedZeroOrder::new(model, options)?;
-    speeds_rpm
-        .iter()
-        .map(|&speed_rpm| prepared.limiting_depth(speed_rpm))
-        .collect()
-}
-
-/// [`limiting_depths`] at one speed.
-pub fn limiting_depth(
-    model: &ModalModel,
-    speed_rpm: f64,
-    options: &ZeroOrderOptions,
-) -> Result<LobePoint> {
-    match limiting_depths(model, &[speed_rpm], options)?.pop() {
-        Some(point) => Ok(point),
-        None => invalid("speed_rpm", speed_rpm, "a spindle speed > 0"),
-    }
+    PreparedZeroOrder::new(model, options)?.limiting_depths(speeds_rpm)
 }
 
 /// Zero-order limiting depths at the given speeds with the structural damping only (the
@@ -206,11 +214,11 @@ pub fn zoa_lobes(model: &ModalModel, speeds_rpm: &[f64]) -> Result<Vec<LobePoint
 
 /// Zero-order limiting depth at one speed, as [`zoa_lobes`].
 pub fn zoa_limiting_depth(model: &ModalModel, speed_rpm: f64) -> Result<LobePoint> {
-    limiting_depth(
+    PreparedZeroOrder::new(
         &model.with_process_damping(None)?,
-        speed_rpm,
         &ZeroOrderOptions::unbounded(),
-    )
+    )?
+    .limiting_depth(speed_rpm)
 }
 
 #[cfg(test)]

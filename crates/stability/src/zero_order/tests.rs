@@ -252,17 +252,19 @@ fn ceilings_and_bad_inputs() {
         ..Default::default()
     };
     assert!(
-        limiting_depth(&model, 300.0, &options)
+        PreparedZeroOrder::new(&model, &options)
+            .unwrap()
+            .limiting_depth(300.0)
             .unwrap()
             .depth_m
             .is_infinite()
     );
-    assert!(limiting_depth(&model, -1.0, &options).is_err());
+    assert!(limiting_depths(&model, &[-1.0], &options).is_err());
     let bad = ZeroOrderOptions {
         relative_tolerance: 0.0,
         ..Default::default()
     };
-    assert!(limiting_depth(&model, 300.0, &bad).is_err());
+    assert!(limiting_depths(&model, &[300.0], &bad).is_err());
     let table = LobeTable::new(OrientedSystem::from_model(&model).unwrap());
     assert!(table.lobes(0.0, 1).is_err());
     assert!(table.lobes(0.1, 0).unwrap().is_empty());

@@ -1,0 +1,229 @@
+//! The characteristic equation of turning (Ahmadi 2022, seed 000, Section 2.1, Eq. 5-6 and 28)
+//! and Newton's method on it: the one home of the closed-loop poles, for the frequency-domain
+//! solver ([`crate::frequency_domain`]) and the pole likelihood of `chatter-updating`.
+//!
+//! In modal coordinates (N x N; the force written as -a K_c (x - x_tau))
+//!
+//! D(lambda) = lambda^2 I + 2 Omega Z lambda + Omega^2 + a Phi^T K_c Phi (1 - e^{-lambda tau})
+//!           + a lambda Phi^T D Phi,
+//!
+//! and the closed-loop poles at width a are the roots of det D(lambda) = 0. The last term is the
+//! optional process damping (003 Eq. 1), F_d = -a D xdot with the constant
+//! D = (C / V) e_feed e_feed^T of turning ([`ModalModel::process_damping_matrix`]; zero for a
+//! model without process damping): exact, as in the discretizations, since nothing is averaged.
+//!
+//! Newton's step is det D / (det D)' = 1 / tr(D^{-1} D') (Jacobi's formula), with
+//! D' = 2 lambda I + 2 Omega Z + a tau Phi^T K_c Phi e^{-lambda tau} + a Phi^T D Phi.
+
+use crate::error::{Result, StabilityError};
+use chatter_dynamics::{ModalModel, Operation};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// Relative Newton step on lambda below which a root counts as converged.
+const NEWTON_TOL: f64 = 1e-13;
+/// A relative Newton step below which a step that stops shrinking is round-off (the floor of
+/// det D near a multiple or clustered root).
+const ROUND_OFF_TOL: f64 = 1e-10;
+
+/// The characteristic matrix D(lambda) of a turning model at one spindle speed, per unit width
+/// in its cutting terms.
+#[derive(Debug, Clone)]
+pub struct Characteristic {
+    omegas: Vec<f64>,
+    zetas: Vec<f64>,
+    /// Phi^T K_c Phi (N x N, per unit width).
+    coupling: DMatrix<f64>,
+    /// Phi^T D Phi: process damping per unit width in modal coordinates (zero without it).
+    process_damping: DMatrix<f64>,
+    tau: f64,
+}
+
+impl Characteristic {
+    /// The characteristic equation of the turning `model` at `speed_rpm`, with the model's
+    /// process damping when it has one; milling is [`StabilityError::Unsupported`] (its
+    /// directional matrix is periodic, not constant).
+    pub fn new(model: &ModalModel, speed_rpm: f64) -> Result<Self> {
+        if !matches!(model.operation(), Operation::Turning(_)) {
+            return Err(StabilityError::Unsupported {
+                method: "frequency-domain poles",
+                reason: "the characteristic equation with constant K_c is for turning".into(),
+            });
+        }
+        model.require_proportional("the frequency-domain method")?;
+        let phi = model.shape_matrix();
+        let h = model.directional_matrix(0.0, speed_rpm);
+        let hm = DMatrix::from_fn(2, 2, |i, j| h[(i, j)]);
+        let d = model.process_damping_matrix(0.0, speed_rpm);
+        let dm = DMatrix::from_fn(2, 2, |i, j| d[(i, j)]);
+        Ok(Self {
+            omegas: model.omegas_rad_s(),
+            zetas: model.damping_ratios(),
+            coupling: phi.transpose() * hm * &phi,
+            process_damping: phi.transpose() * dm * &phi,
+            tau: model.operation().delay_s(speed_rpm),
+        })
+    }
+
+    /// The delay tau (s).
+    pub fn delay_s(&self) -> f64 {
+        self.tau
+    }
+
+    /// The natural frequencies (rad/s) of the modes.
+    pub fn omegas_rad_s(&self) -> &[f64] {
+        &self.omegas
+    }
+
+    /// The diagonal entry i of Phi^T K_c Phi (N/m^2 per unit width): the cutting stiffness mode
+    /// i sees.
+    pub fn coupling_diagonal(&self, i: usize) -> f64 {
+        self.coupling[(i, i)]
+    }
+
+    /// Entry (i, j) of D(lambda) at width `a`; `e` = e^{-lambda tau}.
+    fn entry(&self, lambda: Complex64, a: f64, e: Complex64, i: usize, j: usize) -> Complex64 {
+        let mut v = (Complex64::new(1.0, 0.0) - e) * a * self.coupling[(i, j)]
+            + lambda * a * self.process_damping[(i, j)];
+        if i == j {
+            v += lambda * lambda
+                + 2.0 * self.zetas[i] * self.omegas[i] * lambda
+                + self.omegas[i] * self.omegas[i];
+        }
+        v
+    }
+
+    /// Entry (i, j) of D'(lambda) at width `a`; `e` = e^{-lambda tau}.
+    fn derivative(&self, lambda: Complex64, a: f64, e: Complex64, i: usize, j: usize) -> Complex64 {
+        let mut v = e * a * self.tau * self.coupling[(i, j)] + a * self.process_damping[(i, j)];
+        if i == j {
+            v += 2.0 * lambda + 2.0 * self.zetas[i] * self.omegas[i];
+        }
+        v
+    }
+
+    /// det D(lambda) at width `a` (000 Eq. 28).
+    pub fn determinant(&self, lambda: Complex64, a: f64) -> Complex64 {
+        let e = (-lambda * self.tau).exp();
+        let d = |i, j| self.entry(lambda, a, e, i, j);
+        match self.omegas.len() {
+            1 => d(0, 0),
+            2 => d(0, 0) * d(1, 1) - d(0, 1) * d(1, 0),
+            n => DMatrix::from_fn(n, n, d).determinant(),
+        }
+    }
+
+    /// Newton step 1 / tr(D^{-1} D') at width `a`; `None` where D' vanishes. With one or two
+    /// modes (most models inside samplers) tr(D^{-1} D') = (det D)' / det D in closed form,
+    /// without allocation.
+    pub fn newton_step(&self, lambda: Complex64, a: f64) -> Option<Complex64> {
+        let n = self.omegas.len();
+        let e = (-lambda * self.tau).exp();
+        let entry = |i: usize, j: usize| self.entry(lambda, a, e, i, j);
+        let derivative = |i: usize, j: usize| self.derivative(lambda, a, e, i, j);
+        let (det, det_derivative) = match n {
+            1 => (entry(0, 0), derivative(0, 0)),
+            2 => {
+                let (d00, d01, d10, d11) = (entry(0, 0), entry(0, 1), entry(1, 0), entry(1, 1));
+                let (p00, p01, p10, p11) = (
+                    derivative(0, 0),
+                    derivative(0, 1),
+                    derivative(1, 0),
+                    derivative(1, 1),
+                );
+                (
+                    d00 * d11 - d01 * d10,
+                    p00 * d11 + d00 * p11 - p01 * d10 - d01 * p10,
+                )
+            }
+            _ => {
+                let d = DMatrix::from_fn(n, n, entry);
+                let dd = DMatrix::from_fn(n, n, derivative);
+                // an exactly singular D means lambda is already a root: no step
+                let Some(x) = d.lu().solve(&dd) else {
+                    return Some(Complex64::new(0.0, 0.0));
+                };
+                let tr = x.trace();
+                return (tr.norm() > 0.0).then(|| Complex64::new(1.0, 0.0) / tr);
+            }
+        };
+        if det.norm() == 0.0 {
+            return Some(Complex64::new(0.0, 0.0));
+        }
+        (det_derivative.norm() > 0.0).then(|| det / det_derivative)
+    }
+
+    /// The root reached by Newton's method from `start` at width `a` within `iterations`;
+    /// `None` when it does not converge. Converged when the step falls below 1e-13 |lambda|, or
+    /// below 1e-10 |lambda| without shrinking further (the round-off floor of det D near a
+    /// multiple or clustered root).
+    pub fn newton(&self, start: Complex64, a: f64, iterations: usize) -> Option<Complex64> {
+        self.newton_within(start, a, iterations, f64::INFINITY)
+    }
+
+    /// [`Self::newton`], abandoned (`None`) as soon as an iterate lies farther than
+    /// `max_distance` x |start| from `start`: the root of the branch that `start` identifies,
+    /// not another one.
+    pub fn newton_within(
+        &self,
+        start: Complex64,
+        a: f64,
+        iterations: usize,
+        max_distance: f64,
+    ) -> Option<Complex64> {
+        let mut lambda = start;
+        let mut previous = f64::INFINITY;
+        for _ in 0..iterations {
+            let step = self.newton_step(lambda, a)?;
+            lambda -= step;
+            if !(lambda.re.is_finite() && lambda.im.is_finite())
+                || (lambda - start).norm() > max_distance * start.norm()
+            {
+                return None;
+            }
+            let size = step.norm() / lambda.norm();
+            if size <= NEWTON_TOL || (size <= ROUND_OFF_TOL && size >= 0.5 * previous) {
+                return Some(lambda);
+            }
+            previous = size;
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use chatter_dynamics::examples;
+
+    /// At zero width the structural poles -zeta w + i w sqrt(1 - zeta^2) are roots: det D is
+    /// rounding (its scale is w^4), and Newton stays there.
+    #[test]
+    fn structural_poles_are_roots_at_zero_width() {
+        let model = examples::ahmadi_2022_turning();
+        let ch = Characteristic::new(&model, 7000.0).unwrap();
+        for m in model.modes() {
+            let (w, z) = (m.omega_rad_s(), m.damping_ratio());
+            let pole = Complex64::new(-z * w, w * (1.0 - z * z).sqrt());
+            assert!(ch.determinant(pole, 0.0).norm() < 1e-6 * w.powi(4));
+            let root = ch.newton(pole, 0.0, 5).unwrap();
+            assert!((root - pole).norm() < 1e-9 * w, "{root} {pole}");
+        }
+        let mill = examples::schmitz_2023_milling();
+        assert!(Characteristic::new(&mill, 7000.0).is_err());
+    }
+
+    /// Near a root the Newton step is the distance to it (to first order), and a bound on the
+    /// distance from the start rejects a start on another branch.
+    #[test]
+    fn newton_step_is_the_distance_to_the_root() {
+        let model = examples::ahmadi_2022_turning();
+        let ch = Characteristic::new(&model, 7150.0).unwrap();
+        let start = chatter_dynamics::pole::pole_from_frequency_damping(2473.0, 0.0012);
+        let root = ch.newton_within(start, 2.286e-3, 60, 0.2).unwrap();
+        let near = root + Complex64::new(0.05, 0.3);
+        let step = ch.newton_step(near, 2.286e-3).unwrap();
+        assert!((step - (near - root)).norm() < 1e-3 * (near - root).norm());
+        assert!(ch.newton_within(start, 2.286e-3, 60, 1e-9).is_none());
+    }
+}
