@@ -4,9 +4,9 @@
 
 use anyhow::Result;
 use chatter_dynamics::examples;
+use chatter_progress::Silent;
 use chatter_stability::boundary::LobePoint;
 use chatter_uncertainty::sensitivity::{TransitionMap, pole_sensitivity};
-use chatter_progress::Silent;
 use chatter_updating::karandikar;
 use std::fmt::Write as _;
 

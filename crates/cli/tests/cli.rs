@@ -65,7 +65,10 @@ fn inference_data(path: &Path) -> (std::collections::BTreeMap<String, Vec<f64>>,
     let mut posterior = std::collections::BTreeMap::new();
     for v in &group.variables {
         if v.name() != "chain" && v.name() != "draw" {
-            posterior.insert(v.name().to_string(), read(&format!("posterior/{}", v.name())));
+            posterior.insert(
+                v.name().to_string(),
+                read(&format!("posterior/{}", v.name())),
+            );
             assert!(!read(&format!("prior/{}", v.name())).is_empty());
         }
     }
@@ -410,7 +413,10 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
         let draws = posterior["frequency_factor"].len();
         assert!(draws >= 120, "{class}: {draws} draws");
         assert_eq!(log_likelihood.len(), draws * observations, "{class}");
-        assert!(log_likelihood.iter().all(|v| v.is_finite() && *v <= 10.0), "{class}");
+        assert!(
+            log_likelihood.iter().all(|v| v.is_finite() && *v <= 10.0),
+            "{class}"
+        );
     }
     let classes = report["classes"].as_array().unwrap();
     assert_eq!(classes.len(), 5);
@@ -504,7 +510,15 @@ fn update_writes_posterior_summary_model_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("posterior");
     succeed(&mut update(
-        &["--classes", "0.5,1", "--samples", "200", "--seed", "3", "--netcdf"],
+        &[
+            "--classes",
+            "0.5,1",
+            "--samples",
+            "200",
+            "--seed",
+            "3",
+            "--netcdf",
+        ],
         example("ahmadi2022_turning_model.json"),
         example("ahmadi2022_turning_observations.json"),
         &out_dir,

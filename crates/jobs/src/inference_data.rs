@@ -61,7 +61,9 @@ impl InferenceData<'_> {
                     .map(|r| r.get(k).copied().ok_or_else(|| ragged(group, k)))
                     .collect::<Result<_>>()?;
                 let path = format!("{group}/{}", name.replace('/', "_"));
-                let v = b.add_variable_path::<f64>(path, &[chain, draw]).map_err(nc)?;
+                let v = b
+                    .add_variable_path::<f64>(path, &[chain, draw])
+                    .map_err(nc)?;
                 b.write_variable(v, &column).map_err(nc)?;
             }
             tag(&mut b, group)?;
@@ -177,7 +179,11 @@ mod tests {
         .to_netcdf()?;
         let file = NcFile::from_bytes(&bytes).unwrap();
         let read = |path: &str| -> Vec<f64> {
-            file.read_variable_as_f64(path).unwrap().iter().copied().collect()
+            file.read_variable_as_f64(path)
+                .unwrap()
+                .iter()
+                .copied()
+                .collect()
         };
         assert_eq!(read("posterior/a_mm"), vec![1.0, 2.0, 3.0]);
         assert_eq!(read("posterior/b_hz"), vec![10.0, 20.0, 30.0]);

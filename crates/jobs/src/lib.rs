@@ -11,6 +11,8 @@
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
 //! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
 
+#![cfg_attr(test, allow(clippy::unwrap_used))]
+
 pub mod bands;
 pub mod campaign;
 pub mod diagnose;

@@ -3,8 +3,8 @@
 
 use crate::error::{JobError, Result, count};
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_updating::cuts::CutKernel;
 use chatter_progress::Observer;
+use chatter_updating::cuts::CutKernel;
 
 use chatter_updating::parameters::ModelParameter;
 use chatter_updating::plan::{PlanOutcome, PlanSettings, Strategy, plan_next_cut};

@@ -15,10 +15,10 @@
 //! the paths and the RSS use the automatic resolution (no inverse crime).
 
 use chatter_dynamics::{Cut, ModeShape, examples};
+use chatter_progress::Silent;
 use chatter_stability::boundary;
 use chatter_stability::monodromy::Discretization;
 use chatter_updating::cuts::CutKernel;
-use chatter_progress::Silent;
 use chatter_updating::karandikar::{self, PAPER_PRIOR_P_STABLE, PAPER_PRIOR_SD_C};
 
 /// Tolerances of the issue: P_s within 0.1, expected reductions within 5 points.

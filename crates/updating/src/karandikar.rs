@@ -16,12 +16,12 @@
 
 use crate::cuts::CutKernel;
 use crate::ensemble::BoundaryEnsemble;
-use chatter_progress::Observer;
-use chatter_stability::prepared::SolverOptions;
 use crate::error::{Result, UpdatingError};
 use crate::parameters::{ModelParameter, Parameterization};
 use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{Cut, ModalModel};
+use chatter_progress::Observer;
+use chatter_stability::prepared::SolverOptions;
 
 /// Deepest cut the tool allows (cutting-edge length, 003): 7.5 mm.
 pub const MAX_DEPTH_M: f64 = 7.5e-3;
