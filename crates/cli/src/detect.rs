@@ -108,6 +108,10 @@ pub fn run(args: &DetectArgs) -> Result<()> {
         };
         options.once_per_rev_channel = record.once_per_rev_channel.clone();
         options.interference = interference.clone();
+        options.teeth = model.as_ref().and_then(|m| match m.operation() {
+            Operation::Milling(milling) => Some(milling.teeth()),
+            _ => None,
+        });
         let detection = detect(&signals, &options).with_context(context)?;
         if let Some(folder) = &mut plots {
             let svg = draw(record, model.as_ref(), &detection).with_context(context)?;
@@ -172,6 +176,17 @@ pub(crate) fn interference_note(interference: &Interference, d: &Detection) -> S
 
 fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estimated: bool) -> Cut {
     let e = &d.evidence;
+    // the line that decided: the whole record's, or the windows' when only they chatter
+    let windowed = e
+        .windows
+        .as_ref()
+        .and_then(|w| w.chatter.as_ref().zip(w.margin));
+    let (line_hz, line_variation, margin) = match windowed {
+        Some((span, m)) if d.chatter_hz == Some(span.line_hz) => {
+            (span.line_hz, span.line_variation, m)
+        }
+        _ => (e.peak_hz, e.line_variation, e.margin),
+    };
     let name = record.file.file_name().map_or_else(
         || record.file.display().to_string(),
         |n| n.to_string_lossy().into(),
@@ -196,19 +211,41 @@ fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estima
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,
         note: Some(format!(
-            "detect {name}{speed_note}{}",
-            interference_note(interference, d)
+            "detect {name}{speed_note}{}{}",
+            interference_note(interference, d),
+            windows_note(d)
         )),
         evidence: Some(CutEvidence {
             fundamental_hz: e.fundamental_hz,
-            line_hz: e.peak_hz,
-            line_variation: e.line_variation,
-            margin: e.margin,
+            line_hz,
+            line_variation,
+            margin,
             line_to_forced_db: e.line_to_forced_db,
             line_to_floor_db: e.line_to_floor_db,
             line_to_rest_db: e.line_to_rest_db,
             resolution_hz: e.resolution_hz,
         }),
+    }
+}
+
+/// The window-by-window judgement, for a note: the chattering span, or the best margin.
+fn windows_note(d: &Detection) -> String {
+    let Some(w) = &d.evidence.windows else {
+        return "; record shorter than 1.5 windows: judged whole".into();
+    };
+    let frame = format!(
+        "{} windows of {:.2} s (chatter counts from {:.2} s)",
+        w.windows.len(),
+        w.window_s,
+        w.min_duration_s
+    );
+    match (&w.chatter, w.margin) {
+        (Some(c), Some(m)) => format!(
+            "; {frame}: chatter at {:.1} Hz from {:.1} to {:.1} s (V {:.2}, margin {m:+.3})",
+            c.line_hz, c.start_s, c.end_s, c.line_variation
+        ),
+        (_, Some(m)) => format!("; {frame}: no sustained chatter (margin {m:+.3})"),
+        _ => format!("; {frame}: no line standing out in two neighbouring windows"),
     }
 }
 

@@ -266,8 +266,19 @@ enum Comb {
 /// harmonic, 0.2 / sqrt(k) at the others, fixed phases), and 10 % white measurement noise; 4 s
 /// at 10 kHz, two channels.
 fn built_record(chatter_hz: Option<f64>, mains: Option<(f64, Comb)>, seed: u64) -> Signals {
+    built(4.0, chatter_hz.map(|f| (f, 0.0, f64::INFINITY)), mains, seed)
+}
+
+/// [`built_record`] over `duration_s`, its self-excited line (frequency, onset, end in s) growing
+/// from its onset and cut off at its end.
+fn built(
+    duration_s: f64,
+    line: Option<(f64, f64, f64)>,
+    mains: Option<(f64, Comb)>,
+    seed: u64,
+) -> Signals {
     let fs = 10_000.0;
-    let n = 40_000;
+    let n = (duration_s * fs) as usize;
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     // resonance: exact discretization of x'' + 2 z w x' + w^2 x = noise, by its AR(2) form
     let (w, z) = (2.0 * std::f64::consts::PI * 1100.0, 0.01);
@@ -286,8 +297,11 @@ fn built_record(chatter_hz: Option<f64>, mains: Option<(f64, Comb)>, seed: u64) 
                 (2.0 * std::f64::consts::PI * 80.0 * h as f64 * t + 0.3 * h as f64).cos() / h as f64
             })
             .sum();
-        let selfexcited = chatter_hz.map_or(0.0, |f| {
-            let amplitude = 0.5 / (1.0 + (0.5 / 1e-3 - 1.0) * (-8.0 * t).exp());
+        let selfexcited = line.map_or(0.0, |(f, on, off)| {
+            if t < on || t >= off {
+                return 0.0;
+            }
+            let amplitude = 0.5 / (1.0 + (0.5 / 1e-3 - 1.0) * (-8.0 * (t - on)).exp());
             amplitude * (2.0 * std::f64::consts::PI * f * t).sin()
         });
         let hum: f64 = mains.map_or(0.0, |(f, comb)| {
@@ -394,6 +408,65 @@ fn mains_combs_are_found_and_left_out() {
         );
         assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
         assert!(close(d.chatter_hz.unwrap(), 1300.8, &d), "{:?}", d.evidence);
+    }
+}
+
+/// Chatter in part of a record (window-by-window judgement): 20 s built records (as above) whose
+/// self-excited line is present only from 1 to 10 s or from 12 to 20 s (grown as above from
+/// its onset, cut off at its end). The whole-record criterion, which judges the second half,
+/// calls the early episode stable; the windows (3.28 s) find both at their frequency, in a span
+/// within a window of the episode. The same records without the line stay stable window by
+/// window. (A window holding the onset or the end has V about 1 here, so an episode is found
+/// when two neighbouring windows fit in its steady part: at least 2 windows long.)
+#[test]
+fn chatter_in_part_of_a_record_is_found_by_the_windows() {
+    let options = DetectionOptions::new(80.0);
+    for seed in 0..3 {
+        let stable = built(20.0, None, None, seed);
+        let d = detect(&stable, &options).unwrap();
+        let w = d.evidence.windows.clone().unwrap();
+        eprintln!(
+            "seed {seed}, no episode: {:?}, windows margin {:?}, {} windows of {:.2} s",
+            d.verdict,
+            w.margin,
+            w.windows.len(),
+            w.window_s
+        );
+        assert_eq!(d.verdict, Verdict::Stable, "{:?}", d.evidence);
+        assert!(w.chatter.is_none(), "{w:?}");
+        for (on, off) in [(1.0, 10.0), (12.0, 20.0)] {
+            let d = detect(&built(20.0, Some((1234.5, on, off)), None, seed), &options).unwrap();
+            let w = d.evidence.windows.clone().unwrap();
+            for j in &w.windows {
+                eprintln!(
+                    "  window {:5.2} s: line {:7.1} Hz, {:5.1} dB, V {:?}, margin {:?}",
+                    j.start_s, j.line_hz, j.line_to_floor_db, j.line_variation, j.margin
+                );
+            }
+            let span = w.chatter.clone().unwrap();
+            eprintln!(
+                "seed {seed}, episode {on}-{off} s: {:?} at {:?} Hz (whole record: V {:.2}, margin {:+.2}); windows: {:.1}-{:.1} s, V {:.2}, margin {:?}",
+                d.verdict,
+                d.chatter_hz,
+                d.evidence.line_variation,
+                d.evidence.margin,
+                span.start_s,
+                span.end_s,
+                span.line_variation,
+                w.margin
+            );
+            assert_eq!(d.verdict, Verdict::Chatter);
+            assert!((d.chatter_hz.unwrap() - 1234.5).abs() <= d.evidence.resolution_hz);
+            assert!(
+                span.start_s <= on + w.window_s && span.end_s >= off - w.window_s,
+                "{span:?}"
+            );
+            assert!(span.end_s - span.start_s >= w.min_duration_s, "{span:?}");
+            if off <= 10.0 {
+                // the second half holds no chatter: only the windows find it
+                assert!(d.evidence.margin < 0.0, "{:?}", d.evidence);
+            }
+        }
     }
 }
 
@@ -562,6 +635,18 @@ fn real_mp3_clips_with_the_speed_unknown() {
             e.margin,
             e.interference.as_ref().map(|c| c.fundamental_hz)
         );
+        if let Some(w) = &e.windows {
+            for j in &w.windows {
+                eprintln!(
+                    "  window {:5.1} s: line {:7.1} Hz, {:5.1} dB over floor, V {:?}, margin {:?}",
+                    j.start_s, j.line_hz, j.line_to_floor_db, j.line_variation, j.margin
+                );
+            }
+            eprintln!(
+                "  windows of {:.2} s, at least {:.2} s: margin {:?}, chatter {:?}",
+                w.window_s, w.min_duration_s, w.margin, w.chatter
+            );
+        }
         if file.contains("nochatter") {
             assert!((e.fundamental_hz - 91.6).abs() < 0.1, "{e:?}");
             assert_eq!(d.verdict, Verdict::Stable, "{e:?}");
