@@ -64,7 +64,11 @@ fn machine() -> ModalModel {
 
 /// The truth's solver: the full discretization at 4x its automatic resolution (at least 200).
 fn truth(model: &ModalModel, speed_rpm: f64) -> Discretization {
-    let m = match Discretization::full().resolved(model, speed_rpm).unwrap().steps {
+    let m = match Discretization::full()
+        .resolved(model, speed_rpm)
+        .unwrap()
+        .steps
+    {
         StepsPerDelay::Fixed(m) => m,
         StepsPerDelay::Auto => 50,
     };

@@ -50,8 +50,27 @@
 //! lines with a fundamental in 45-65 Hz is searched for (see [`crate::interference`]) and its
 //! member lines are synchronous as well; the comb found is reported in
 //! [`DetectionEvidence::interference`]. Known fundamentals ([`Interference::Known`]) make every
-//! one of their multiples synchronous instead. Period-doubling (flip) chatter of a cutter with an even
-//! number of teeth lies on spindle harmonics and is not detected.
+//! one of their multiples synchronous instead.
+//!
+//! # Flip chatter
+//! Period-doubling (flip) chatter of a cutter with an even number z of teeth vibrates at the odd
+//! multiples of half the tooth-passing frequency, (2k + 1) z f_0 / 2: spindle harmonics, which
+//! the criterion above takes for forced response. With the tooth count given
+//! ([`DetectionOptions::teeth`], even), those flip lines are judged apart. A stable cut has
+//! lines there too: the spindle-periodic forcing (runout, here the simulator's harmonics at 1-4
+//! f_0) reaches every spindle harmonic through the tooth-periodic cut, and is constant, so V
+//! cannot tell them from a limit cycle. Their level can: forced lines at the flip harmonics are
+//! of the order of those at the "runout-only" harmonics (multiples of f_0 that are neither tooth
+//! harmonics nor flip lines, e.g. the odd ones for 4 teeth), while a flip limit cycle stands far
+//! above them. So the strongest flip line in the band is flip chatter when its V (second half,
+//! as above) is at most the limit-cycle threshold, it stands [`MIN_LINE_TO_FLOOR_DB`] above the
+//! floor and [`MIN_FLIP_TO_RUNOUT_DB`] = 16 dB above the strongest runout-only line
+//! ([`FlipEvidence`]). The threshold is from the proving ground's xy machine (`examples/
+//! milling_study.rs`: 4 teeth, 30 %, 72 simulated records): stable records reach +10.0 dB, its
+//! three flip-chatter records +22.6 to +25.0 dB; it is checked on another machine (seed 001's,
+//! `tests/detection.rs`). With two teeth there is no runout-only harmonic and flip chatter is
+//! not judged; a record that is chatter by the main criterion keeps its line. Judged on the whole
+//! record only, not window by window.
 //!
 //! The chatter frequency is the line's, refined by a parabola through the logarithms of the
 //! three densities around it.
@@ -101,6 +120,9 @@ pub const HARMONIC_TOLERANCE: f64 = 5e-4;
 /// Default relative search range of the fundamental around its nominal value.
 pub const SPEED_TOLERANCE: f64 = 0.005;
 
+/// A flip line is flip chatter only when it stands this far above the strongest runout-only
+/// spindle harmonic (dB; see the [module documentation](self#flip-chatter)).
+pub const MIN_FLIP_TO_RUNOUT_DB: f64 = 16.0;
 /// Window length, in spectrum segments, of the window-by-window judgement (so a window's
 /// density averages 2 x 4 - 1 = 7 half-overlapping segments and its line variation about 29
 /// short segments, as many as the whole-record criterion uses on a 4 s record).
@@ -266,6 +288,15 @@ pub struct FlipEvidence {
     pub line_to_runout_db: Option<f64>,
     /// Coefficient of variation of its share of the power over the record's second half.
     pub line_variation: f64,
+    /// Limit-cycle threshold - V (positive: a limit cycle).
+    pub variation_margin: f64,
+    /// line_to_runout_db - [`MIN_FLIP_TO_RUNOUT_DB`] (dB; positive: not runout); `None` with two
+    /// teeth.
+    pub runout_margin_db: Option<f64>,
+    /// Flip chatter: a limit cycle (V at most the limit-cycle threshold) at least
+    /// [`MIN_FLIP_TO_RUNOUT_DB`] above the runout lines and [`MIN_LINE_TO_FLOOR_DB`] above the
+    /// floor.
+    pub chatter: bool,
 }
 
 /// One window of the record judged on its own (see the [module documentation](self#windows)).
@@ -569,21 +600,26 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
         options,
     );
     let flip = match options.teeth {
-        Some(teeth) if teeth >= 2 && teeth % 2 == 0 => flip_lines(
-            &psd,
-            floor,
-            f0,
-            teeth,
-            (first, last),
-            df,
-            second_half,
-        ),
+        Some(teeth) if teeth >= 2 && teeth % 2 == 0 => {
+            flip_lines(&psd, floor, f0, teeth, (first, last), df, second_half).map(|mut f| {
+                f.variation_margin = options.max_line_variation - f.line_variation;
+                f.runout_margin_db = f.line_to_runout_db.map(|r| r - MIN_FLIP_TO_RUNOUT_DB);
+                f.chatter = f.variation_margin >= 0.0
+                    && f.runout_margin_db.is_some_and(|m| m >= 0.0)
+                    && f.line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
+                f
+            })
+        }
         _ => None,
     };
     let chatter_hz = if whole {
         Some(peak_hz)
     } else {
-        windowed.as_ref().and_then(|w| w.chatter.as_ref()).map(|c| c.line_hz)
+        windowed
+            .as_ref()
+            .and_then(|w| w.chatter.as_ref())
+            .map(|c| c.line_hz)
+            .or_else(|| flip.as_ref().filter(|f| f.chatter).map(|f| f.line_hz))
     };
     let chatter = chatter_hz.is_some();
     let harmonics_hz = (1..)
@@ -695,6 +731,9 @@ fn flip_lines(
         line_to_forced_db: db(psd[bin], forced),
         line_to_runout_db: runout.map(|r| db(psd[bin], r)),
         line_variation: variation(bin),
+        variation_margin: f64::NAN,
+        runout_margin_db: None,
+        chatter: false,
     })
 }
 
@@ -834,7 +873,11 @@ fn judge_windows(
                 .fold(f64::INFINITY, f64::min);
             let strongest = run
                 .iter()
-                .max_by(|a, b| a.0.margin.partial_cmp(&b.0.margin).unwrap_or(std::cmp::Ordering::Equal))
+                .max_by(|a, b| {
+                    a.0.margin
+                        .partial_cmp(&b.0.margin)
+                        .unwrap_or(std::cmp::Ordering::Equal)
+                })
                 .map(|j| &j.0)?;
             let span = ChatterSpan {
                 start_s: run[0].0.start_s,
@@ -842,9 +885,9 @@ fn judge_windows(
                 line_hz: strongest.line_hz,
                 line_variation: strongest.line_variation.unwrap_or(f64::NAN),
             };
-            let better = best
-                .as_ref()
-                .is_none_or(|(len, m, _)| run.len() > *len || (run.len() == *len && run_margin > *m));
+            let better = best.as_ref().is_none_or(|(len, m, _)| {
+                run.len() > *len || (run.len() == *len && run_margin > *m)
+            });
             if better {
                 best = Some((run.len(), run_margin, span));
             }
