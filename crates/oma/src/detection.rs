@@ -124,12 +124,16 @@ pub const SPEED_TOLERANCE: f64 = 0.005;
 /// spindle harmonic (dB; see the [module documentation](self#flip-chatter)).
 pub const MIN_FLIP_TO_RUNOUT_DB: f64 = 16.0;
 /// Window length, in spectrum segments, of the window-by-window judgement (so a window's
-/// density averages 2 x 4 - 1 = 7 half-overlapping segments and its line variation about 29
-/// short segments, as many as the whole-record criterion uses on a 4 s record).
+/// density averages 2 x 4 - 1 = 7 half-overlapping segments and its line variation 15
+/// short segments, about as many as the whole-record criterion uses on a 4 s record).
 pub const WINDOW_SEGMENTS: usize = 4;
 /// Consecutive windows (each shifted by half a window) that must chatter at the same line: a
 /// sustained chatter lasts at least 1.5 windows (6 spectrum segments).
 pub const MIN_SUSTAINED_WINDOWS: usize = 2;
+/// A window's short segments (half a spectrum segment) start every 1 / this of their length:
+/// half-overlapping Hann segments, nearly all of the information at half the cost of the whole
+/// record's quarter hop (the window judgement costs about as much as the rest of the detection).
+pub const WINDOW_HOPS_PER_SEGMENT: usize = 2;
 /// Two windows' lines are the same line when they lie within this many bins.
 pub const LINE_MATCH_BINS: f64 = 2.0;
 
@@ -309,8 +313,9 @@ pub struct WindowJudgement {
     /// Its peak density over the window's floor (dB).
     pub line_to_floor_db: f64,
     /// Coefficient of variation of its share of the power over the window's short segments;
-    /// `None` when the line does not stand [`MIN_LINE_TO_FLOOR_DB`] above the floor (not
-    /// computed).
+    /// `None` (not computed: it cannot make a sustained chatter) unless the line stands
+    /// [`MIN_LINE_TO_FLOOR_DB`] above the floor in this window and in a neighbouring one whose
+    /// line lies within [`LINE_MATCH_BINS`].
     pub line_variation: Option<f64>,
     /// Distance of that variation to the nearer threshold (positive: the window chatters).
     pub margin: Option<f64>,
@@ -586,7 +591,8 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let line_to_forced_db = 10.0 * ((e_line + tiny) / (e_sync + floor * df)).log10();
     let line_to_floor_db = 10.0 * (psd[peak] / floor.max(tiny)).log10();
     let peak_hz = refine_peak_hz(&psd, peak, df);
-    let second_half = |bin: usize| line_variation(&signals.data, &stats, segment, bin, (n / 2, n));
+    let second_half =
+        |bin: usize| line_variation(&signals.data, &stats, segment, bin, (n / 2, n), 4);
     let variation = second_half(peak);
     let margin = variation_margin(variation, options);
     let whole = margin >= 0.0 && line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
@@ -811,26 +817,44 @@ fn judge_windows(
     }
     let count = (segment_psd.len() - per_window) / hop + 1;
     let half = segment / 2;
-    let judged: Vec<(WindowJudgement, usize)> = (0..count)
+    // each window's line first (cheap: the densities are there)
+    let lines: Vec<Option<(usize, f64, f64)>> = (0..count)
         .into_par_iter()
-        .filter_map(|w| {
+        .map(|w| {
             let psd = mean_density(&segment_psd[w * hop..w * hop + per_window]);
             let (floor, peak) = floor_and_peak(&psd, synchronous, first, last)?;
             let line_to_floor_db = 10.0 * (psd[peak] / floor.max(f64::MIN_POSITIVE)).log10();
+            Some((peak, refine_peak_hz(&psd, peak, df), line_to_floor_db))
+        })
+        .collect();
+    // the line's variation only where it can matter: the line stands out of the floor and a
+    // neighbouring window has it too
+    let stands = |w: usize| lines[w].filter(|l| l.2 >= MIN_LINE_TO_FLOOR_DB);
+    let paired = |a: usize, b: usize| {
+        stands(a)
+            .zip(stands(b))
+            .is_some_and(|(x, y)| (x.1 - y.1).abs() <= LINE_MATCH_BINS * df)
+    };
+    let judged: Vec<(WindowJudgement, usize)> = (0..count)
+        .into_par_iter()
+        .filter_map(|w| {
+            let (peak, line_hz, line_to_floor_db) = lines[w]?;
             let start = w * hop * half;
-            let variation = (line_to_floor_db >= MIN_LINE_TO_FLOOR_DB).then(|| {
+            let needed = (w > 0 && paired(w - 1, w)) || (w + 1 < count && paired(w, w + 1));
+            let variation = needed.then(|| {
                 line_variation(
                     data,
                     stats,
                     segment,
                     peak,
                     (start, start + WINDOW_SEGMENTS * segment),
+                    WINDOW_HOPS_PER_SEGMENT,
                 )
             });
             Some((
                 WindowJudgement {
                     start_s: start as f64 / fs,
-                    line_hz: refine_peak_hz(&psd, peak, df),
+                    line_hz,
                     line_to_floor_db,
                     line_variation: variation,
                     margin: variation.map(|v| variation_margin(v, options)),
@@ -907,8 +931,8 @@ fn judge_windows(
 /// Coefficient of variation of the line's share of the power over the samples `range` (the line's
 /// power over the segment's power, so that a cut that deepens or leaves the workpiece changes
 /// neither): segments of half the spectrum's length (so the line, at bin `peak` of the
-/// spectrum, falls at bin peak / 2 of theirs), Hann windowed, starting every quarter of their
-/// length from the record's start, the ones wholly inside `range`; the power is summed over the
+/// spectrum, falls at bin peak / 2 of theirs), Hann windowed, starting every
+/// 1 / `hops_per_segment` of their length (a quarter for the whole record) from the record's start, the ones wholly inside `range`; the power is summed over the
 /// three bins around the line and over the channels standardized by `stats` (mean, 1 / standard
 /// deviation).
 fn line_variation(
@@ -917,10 +941,11 @@ fn line_variation(
     spectrum_segment: usize,
     peak: usize,
     (from, to): (usize, usize),
+    hops_per_segment: usize,
 ) -> f64 {
     let n = data[0].len();
     let segment = (spectrum_segment / 2).max(16);
-    let step = (segment / 4).max(1);
+    let step = (segment / hops_per_segment).max(1);
     let centre = (peak as f64 / 2.0).round() as usize;
     if n < segment {
         return f64::NAN;
