@@ -652,18 +652,18 @@ fn real_record_test255_is_chatter() {
 ///   732.8, 1007.4 and 1099.5 Hz are the multiples 1, 4, 8, 11, 12 of 91.6 Hz within 0.3 Hz (a
 ///   four-flute cutter's tooth passing at 366.7 Hz). Verdict stable, as labelled (whole record:
 ///   V 0.318, margin -0.018).
-///   Window by window (5.94 s windows) it stays stable: its line 739.7 Hz has V 0.57 and
-///   0.29 in its two windows, one chattering window is not sustained chatter.
+///   Window by window (5.94 s windows) it stays stable: its line 739.7 Hz has V 0.54 and
+///   0.32 in its two windows.
 /// - `combined_chatter6567.mp3`: the verdict is printed, **not asserted**, because it is right
 ///   for a reason that is not the chatter. Its 1067 Hz line is present only from about 3 to 20 s
 ///   (short-time spectra); the whole-record criterion judges the second half (31-63 s), where
 ///   the clip holds a stationary background without that line (V 0.81: stable). Window by
-///   window, the 1067-1077 Hz line is the strongest from 3 to 21 s, but its V is 2.39, 1.29,
-///   0.66, 0.58, 1.90 (onset, drifting 1077 -> 1067 Hz, end): never two neighbouring chattering
-///   windows. What the windows do find is a constant tone at 2329.9 Hz (V 0.10-0.14) from 17.8 s
+///   window, the 1067-1077 Hz line is the strongest from 3 to 21 s, but its V is 2.35, 1.32,
+///   0.67, 0.62, 1.92 (onset, drifting 1077 -> 1067 Hz, end): never two neighbouring chattering
+///   windows. What the windows do find is a constant tone at 2329.9 Hz (V 0.09-0.17) from 17.8 s
 ///   to the end, one of the background's lines (the first window, before the cut, has another,
 ///   1770.7 Hz, V 0.14): a stationary non-harmonic tone is a limit cycle to this criterion, so
-///   the clip is labelled chatter at 2329.96 Hz. See the signals6 note.
+///   the clip is labelled chatter at 2329.9 Hz. See the signals6 note.
 #[test]
 fn real_mp3_clips_with_the_speed_unknown() {
     let dir = concat!(
