@@ -19,6 +19,12 @@
 //! of the record's harmonic comb in 10-500 Hz (600-30 000 rpm; `chatter_oma::interference::
 //! harmonic_fundamental`); the cut's `speed_rpm` is the estimate, and its note says so.
 //!
+//! With `--model` of a milling machine, its tooth count is used: with an even count, lines at
+//! the odd multiples of half the tooth-passing frequency are judged for period-doubling (flip)
+//! chatter (`chatter_oma::detection`, "Flip chatter"). Records long enough for two windows are
+//! also judged window by window (chatter in part of a record; "Windows"); the note gives the
+//! chattering span or the windows' margin.
+//!
 //! Interference (mains hum): by default a comb of lines at the multiples of a 45-65 Hz
 //! fundamental is searched for (`chatter_oma::interference`) and its lines are left out; the
 //! `note` reports the comb found. `--interference-hz 50` (or a list) gives the fundamentals
@@ -38,8 +44,8 @@ pub struct DetectArgs {
     /// Observations file listing the `signals` (CSV, WAV or MP3).
     #[arg(long)]
     pub observations: PathBuf,
-    /// Machine model: a milling model's tooth count is reported in the plot title (the
-    /// detection itself needs only the spindle frequency).
+    /// Machine model: a milling model's tooth count is used to judge flip (period-doubling)
+    /// chatter with an even count, and is reported in the plot title.
     #[arg(long)]
     pub model: Option<PathBuf>,
     /// Folder for one SVG spectrum per record (detect-1.svg, detect-2.svg, ...).
@@ -108,6 +114,10 @@ pub fn run(args: &DetectArgs) -> Result<()> {
         };
         options.once_per_rev_channel = record.once_per_rev_channel.clone();
         options.interference = interference.clone();
+        options.teeth = model.as_ref().and_then(|m| match m.operation() {
+            Operation::Milling(milling) => Some(milling.teeth()),
+            _ => None,
+        });
         let detection = detect(&signals, &options).with_context(context)?;
         if let Some(folder) = &mut plots {
             let svg = draw(record, model.as_ref(), &detection).with_context(context)?;
@@ -172,6 +182,22 @@ pub(crate) fn interference_note(interference: &Interference, d: &Detection) -> S
 
 fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estimated: bool) -> Cut {
     let e = &d.evidence;
+    // the line that decided: the whole record's, the windows' or the flip line's when only
+    // they chatter
+    let windowed = e
+        .windows
+        .as_ref()
+        .and_then(|w| w.chatter.as_ref().zip(w.margin));
+    let flip = e.flip.as_ref().filter(|f| f.chatter);
+    let (line_hz, line_variation, margin) = match (windowed, flip) {
+        (Some((span, m)), _) if d.chatter_hz == Some(span.line_hz) => {
+            (span.line_hz, span.line_variation, m)
+        }
+        (_, Some(f)) if d.chatter_hz == Some(f.line_hz) => {
+            (f.line_hz, f.line_variation, f.variation_margin)
+        }
+        _ => (e.peak_hz, e.line_variation, e.margin),
+    };
     let name = record.file.file_name().map_or_else(
         || record.file.display().to_string(),
         |n| n.to_string_lossy().into(),
@@ -196,20 +222,56 @@ fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estima
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,
         note: Some(format!(
-            "detect {name}{speed_note}{}",
-            interference_note(interference, d)
+            "detect {name}{speed_note}{}{}{}",
+            interference_note(interference, d),
+            windows_note(d),
+            flip_note(d)
         )),
         evidence: Some(CutEvidence {
             fundamental_hz: e.fundamental_hz,
-            line_hz: e.peak_hz,
-            line_variation: e.line_variation,
-            margin: e.margin,
+            line_hz,
+            line_variation,
+            margin,
             line_to_forced_db: e.line_to_forced_db,
             line_to_floor_db: e.line_to_floor_db,
             line_to_rest_db: e.line_to_rest_db,
             resolution_hz: e.resolution_hz,
         }),
     }
+}
+
+/// The window-by-window judgement, for a note: the chattering span, or the best margin.
+fn windows_note(d: &Detection) -> String {
+    let Some(w) = &d.evidence.windows else {
+        return "; record shorter than 1.5 windows: judged whole".into();
+    };
+    let frame = format!(
+        "{} windows of {:.2} s (chatter counts from {:.2} s)",
+        w.windows.len(),
+        w.window_s,
+        w.min_duration_s
+    );
+    match (&w.chatter, w.margin) {
+        (Some(c), Some(m)) => format!(
+            "; {frame}: chatter at {:.1} Hz from {:.1} to {:.1} s (V {:.2}, margin {m:+.3})",
+            c.line_hz, c.start_s, c.end_s, c.line_variation
+        ),
+        (_, Some(m)) => format!("; {frame}: no sustained chatter (margin {m:+.3})"),
+        _ => format!("; {frame}: no line standing out in two neighbouring windows"),
+    }
+}
+
+/// The flip lines (tooth count known from the model), for a note.
+fn flip_note(d: &Detection) -> String {
+    d.evidence.flip.as_ref().map_or(String::new(), |f| {
+        format!(
+            "; flip line {:.1} Hz: V {:.2}, {:.1} dB over the runout lines{}",
+            f.line_hz,
+            f.line_variation,
+            f.line_to_runout_db.unwrap_or(f64::NAN),
+            if f.chatter { ", flip chatter" } else { "" }
+        )
+    })
 }
 
 /// The spectrum (log scale) over the band, the harmonics as grey ticks, the line as a red

@@ -50,11 +50,49 @@
 //! lines with a fundamental in 45-65 Hz is searched for (see [`crate::interference`]) and its
 //! member lines are synchronous as well; the comb found is reported in
 //! [`DetectionEvidence::interference`]. Known fundamentals ([`Interference::Known`]) make every
-//! one of their multiples synchronous instead. Period-doubling (flip) chatter of a cutter with an even
-//! number of teeth lies on spindle harmonics and is not detected.
+//! one of their multiples synchronous instead.
+//!
+//! # Flip chatter
+//! Period-doubling (flip) chatter of a cutter with an even number z of teeth vibrates at the odd
+//! multiples of half the tooth-passing frequency, (2k + 1) z f_0 / 2: spindle harmonics, which
+//! the criterion above takes for forced response. With the tooth count given
+//! ([`DetectionOptions::teeth`], even), those flip lines are judged apart. A stable cut has
+//! lines there too: the spindle-periodic forcing (runout, here the simulator's harmonics at 1-4
+//! f_0) reaches every spindle harmonic through the tooth-periodic cut, and is constant, so V
+//! cannot tell them from a limit cycle. Their level can: forced lines at the flip harmonics are
+//! of the order of those at the "runout-only" harmonics (multiples of f_0 that are neither tooth
+//! harmonics nor flip lines, e.g. the odd ones for 4 teeth), while a flip limit cycle stands far
+//! above them. So the strongest flip line in the band is flip chatter when its V (second half,
+//! as above) is at most the limit-cycle threshold, it stands [`MIN_LINE_TO_FLOOR_DB`] above the
+//! floor and [`MIN_FLIP_TO_RUNOUT_DB`] = 16 dB above the strongest runout-only line
+//! ([`FlipEvidence`]). The threshold is from the proving ground's xy machine (`examples/
+//! milling_study.rs`: 4 teeth, 30 %, 72 simulated records): stable records reach +10.0 dB, its
+//! three flip-chatter records +22.6 to +25.0 dB; it is checked on another machine (seed 001's,
+//! `tests/detection.rs`). With two teeth there is no runout-only harmonic and flip chatter is
+//! not judged; a record that is chatter by the main criterion keeps its line. Judged on the whole
+//! record only, not window by window.
 //!
 //! The chatter frequency is the line's, refined by a parabola through the logarithms of the
 //! three densities around it.
+//!
+//! # Windows
+//! Chatter that lasts only part of a record (a sound clip of several passes, a cut that chatters
+//! on entry and then settles) is missed by a criterion that judges the record's second half. So
+//! the record is also judged window by window: windows of [`WINDOW_SEGMENTS`] = 4 spectrum
+//! segments (2 to 6 s at the default resolutions) start every half window; each window is judged
+//! like the whole record (its own Welch density from the same segments, floor, strongest
+//! non-synchronous line, the same synchronous bins, and the line's variation V over all of the
+//! window's short segments, not only its second half). The record chatters when the whole-record
+//! criterion says so **or** at least [`MIN_SUSTAINED_WINDOWS`] = 2 consecutive windows chatter at
+//! the same line (within [`LINE_MATCH_BINS`] bins): the chatter must last at least 1.5 windows
+//! (6 spectrum segments). One window alone never decides: the start of a cut (the simulator's
+//! records start from rest with the whole static force applied at once, a step that rings the
+//! structure for a few of its time constants, far below a window) or one burst of a random
+//! resonance make one window's V large, not two windows' at the same line. Records shorter than
+//! 1.5 windows are judged whole only (the simulator sweeps' 4 s records at 10 kHz, for one).
+//! Reported in [`DetectionEvidence::windows`]: every window's line, V and margin, the record's
+//! windowed margin (the best pair of neighbouring windows at the same line, the smaller of their
+//! two margins) and the chattering time span.
 
 use crate::error::{OmaError, Result};
 use crate::interference::{
@@ -62,7 +100,7 @@ use crate::interference::{
     harmonic_fundamental, spectral_lines,
 };
 use crate::signals::Signals;
-use crate::spectrum::{Spectrum, power_spectral_density, refine_peak_hz};
+use crate::spectrum::{Spectrum, refine_peak_hz, segment_densities};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -81,6 +119,23 @@ pub const MIN_LINE_TO_FLOOR_DB: f64 = 20.0;
 pub const HARMONIC_TOLERANCE: f64 = 5e-4;
 /// Default relative search range of the fundamental around its nominal value.
 pub const SPEED_TOLERANCE: f64 = 0.005;
+
+/// A flip line is flip chatter only when it stands this far above the strongest runout-only
+/// spindle harmonic (dB; see the [module documentation](self#flip-chatter)).
+pub const MIN_FLIP_TO_RUNOUT_DB: f64 = 16.0;
+/// Window length, in spectrum segments, of the window-by-window judgement (so a window's
+/// density averages 2 x 4 - 1 = 7 half-overlapping segments and its line variation 15
+/// short segments, about as many as the whole-record criterion uses on a 4 s record).
+pub const WINDOW_SEGMENTS: usize = 4;
+/// Consecutive windows (each shifted by half a window) that must chatter at the same line: a
+/// sustained chatter lasts at least 1.5 windows (6 spectrum segments).
+pub const MIN_SUSTAINED_WINDOWS: usize = 2;
+/// A window's short segments (half a spectrum segment) start every 1 / this of their length:
+/// half-overlapping Hann segments, nearly all of the information at half the cost of the whole
+/// record's quarter hop (the window judgement costs about as much as the rest of the detection).
+pub const WINDOW_HOPS_PER_SEGMENT: usize = 2;
+/// Two windows' lines are the same line when they lie within this many bins.
+pub const LINE_MATCH_BINS: f64 = 2.0;
 
 /// Default range of the spindle frequency searched when it is unknown (Hz): 600 to 30 000 rpm.
 pub const SPINDLE_RANGE_HZ: (f64, f64) = (10.0, 500.0);
@@ -138,6 +193,10 @@ pub struct DetectionOptions {
     /// Interference combs (mains hum) whose lines are synchronous too: searched for in
     /// 45-65 Hz by default, given, or none.
     pub interference: Interference,
+    /// The cutter's number of teeth (milling), if known: with an even number, period-doubling
+    /// (flip) chatter lies on spindle harmonics, at the odd multiples of half the tooth-passing
+    /// frequency, and is looked for there (see the [module documentation](self#flip-chatter)).
+    pub teeth: Option<usize>,
 }
 
 impl DetectionOptions {
@@ -166,6 +225,7 @@ impl DetectionOptions {
             min_burst_variation: MIN_BURST_VARIATION,
             once_per_rev_channel: None,
             interference: Interference::default(),
+            teeth: None,
         }
     }
 }
@@ -209,6 +269,89 @@ pub struct DetectionEvidence {
     pub line_variation: f64,
     /// The interference comb found and left out ([`Interference::Search`]), if any.
     pub interference: Option<InterferenceComb>,
+    /// The record judged window by window ([`WINDOW_SEGMENTS`]); `None` when the record is
+    /// shorter than two windows.
+    pub windows: Option<WindowedEvidence>,
+    /// The flip lines, when the tooth count is known and even.
+    pub flip: Option<FlipEvidence>,
+}
+
+/// The period-doubling (flip) lines of an even-toothed cutter (see the
+/// [module documentation](self#flip-chatter)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlipEvidence {
+    /// Frequency of the strongest line at an odd multiple of half the tooth-passing frequency
+    /// (Hz).
+    pub line_hz: f64,
+    /// Its peak density over the floor (dB).
+    pub line_to_floor_db: f64,
+    /// Its peak density over that of the strongest other spindle harmonic in the band (dB).
+    pub line_to_forced_db: f64,
+    /// Its peak density over that of the strongest spindle harmonic that is neither a tooth
+    /// harmonic nor a flip line (runout only; `None` with two teeth, where there is none) (dB).
+    pub line_to_runout_db: Option<f64>,
+    /// Coefficient of variation of its share of the power over the record's second half.
+    pub line_variation: f64,
+    /// Limit-cycle threshold - V (positive: a limit cycle).
+    pub variation_margin: f64,
+    /// line_to_runout_db - [`MIN_FLIP_TO_RUNOUT_DB`] (dB; positive: not runout); `None` with two
+    /// teeth.
+    pub runout_margin_db: Option<f64>,
+    /// Flip chatter: a limit cycle (V at most the limit-cycle threshold) at least
+    /// [`MIN_FLIP_TO_RUNOUT_DB`] above the runout lines and [`MIN_LINE_TO_FLOOR_DB`] above the
+    /// floor.
+    pub chatter: bool,
+}
+
+/// One window of the record judged on its own (see the [module documentation](self#windows)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WindowJudgement {
+    /// Start of the window (s from the record's start).
+    pub start_s: f64,
+    /// Frequency of the window's strongest non-synchronous line (Hz).
+    pub line_hz: f64,
+    /// Its peak density over the window's floor (dB).
+    pub line_to_floor_db: f64,
+    /// Coefficient of variation of its share of the power over the window's short segments;
+    /// `None` (not computed: it cannot make a sustained chatter) unless the line stands
+    /// [`MIN_LINE_TO_FLOOR_DB`] above the floor in this window and in a neighbouring one whose
+    /// line lies within [`LINE_MATCH_BINS`].
+    pub line_variation: Option<f64>,
+    /// Distance of that variation to the nearer threshold (positive: the window chatters).
+    pub margin: Option<f64>,
+}
+
+/// A run of consecutive chattering windows at the same line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChatterSpan {
+    /// Start of the run's first window (s).
+    pub start_s: f64,
+    /// End of its last window (s).
+    pub end_s: f64,
+    /// The line of the run's window with the largest margin (Hz).
+    pub line_hz: f64,
+    /// Its coefficient of variation.
+    pub line_variation: f64,
+}
+
+/// The record judged window by window: it chatters when at least [`MIN_SUSTAINED_WINDOWS`]
+/// consecutive windows chatter at the same line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WindowedEvidence {
+    /// Window length (s): [`WINDOW_SEGMENTS`] spectrum segments.
+    pub window_s: f64,
+    /// Shift between windows (s): half a window.
+    pub hop_s: f64,
+    /// Shortest chatter that counts (s): [`MIN_SUSTAINED_WINDOWS`] windows, overlapping.
+    pub min_duration_s: f64,
+    /// The largest, over pairs of neighbouring windows whose lines agree within
+    /// [`LINE_MATCH_BINS`] and stand [`MIN_LINE_TO_FLOOR_DB`] above their floors, of the smaller of
+    /// the two margins (positive: the record chatters); `None` when no pair qualifies.
+    pub margin: Option<f64>,
+    /// The longest-lasting sustained chatter (the one with the largest margin among equals), if any.
+    pub chatter: Option<ChatterSpan>,
+    /// Every window.
+    pub windows: Vec<WindowJudgement>,
 }
 
 /// Result of [`detect`].
@@ -314,27 +457,31 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
         ));
     }
     let df = fs / segment as f64;
-    let mut psd = vec![0.0; segment / 2 + 1];
-    // channels in parallel, summed in channel order (independent of the thread count)
-    let densities: Vec<Option<Spectrum>> = signals
+    // each channel's mean and 1 / standard deviation (0 for a constant channel, which carries
+    // nothing)
+    let stats: Vec<(f64, f64)> = signals.data.iter().map(|ch| standardization(ch)).collect();
+    // the Welch segments' densities of the standardized channels, channels in parallel, summed
+    // in channel order (independent of the thread count)
+    let per_channel: Vec<Option<Vec<Vec<f64>>>> = signals
         .data
         .par_iter()
-        .map(|ch| {
-            let mean = ch.iter().sum::<f64>() / n as f64;
-            let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-            if var <= 0.0 {
-                return Ok(None); // a constant channel carries nothing
+        .zip(&stats)
+        .map(|(ch, &(mean, scale))| {
+            if scale == 0.0 {
+                return Ok(None);
             }
-            let scale = 1.0 / var.sqrt();
             let normalized: Vec<f64> = ch.iter().map(|v| (v - mean) * scale).collect();
-            power_spectral_density(&normalized, fs, segment).map(Some)
+            segment_densities(&normalized, fs, segment).map(Some)
         })
         .collect::<Result<_>>()?;
-    for s in densities.into_iter().flatten() {
-        for (a, b) in psd.iter_mut().zip(&s.values) {
-            *a += b;
+    let count = (n - segment) / (segment / 2) + 1;
+    let mut segment_psd = vec![vec![0.0; segment / 2 + 1]; count];
+    for channel in per_channel.into_iter().flatten() {
+        for (acc, d) in segment_psd.iter_mut().zip(channel) {
+            acc.iter_mut().zip(d).for_each(|(a, b)| *a += b);
         }
     }
+    let psd = mean_density(&segment_psd);
     let lo = options.min_frequency_hz.unwrap_or(f0_lowest / 2.0);
     let hi = options.max_frequency_hz.unwrap_or(0.45 * fs).min(nyquist);
     if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo + 8.0 * df) {
@@ -413,26 +560,13 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
         })
         .collect();
     let synchronous = |i: usize| synchronous_bins[i];
-    let mut floor_values: Vec<f64> = (first..=last)
-        .filter(|i| !synchronous(*i))
-        .map(|i| psd[i])
-        .collect();
-    if floor_values.is_empty() {
+    if !(first..=last).any(|i| !synchronous(i)) {
         return Err(invalid(
             "resolution_hz",
             format!("{df} Hz bins leave no bin between the harmonics of {f0} Hz"),
         ));
     }
-    let mid = floor_values.len() / 2;
-    let floor = *floor_values
-        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
-        .1;
-    // strongest non-synchronous local maximum
-    let peak = (first..=last)
-        .filter(|&i| !synchronous(i))
-        .filter(|&i| psd[i] >= psd[i - 1] && psd.get(i + 1).is_none_or(|v| psd[i] >= *v))
-        .max_by(|a, b| psd[*a].total_cmp(&psd[*b]));
-    let Some(peak) = peak else {
+    let Some((floor, peak)) = floor_and_peak(&psd, &synchronous_bins, first, last) else {
         return Err(OmaError::NoPole(
             "no non-synchronous peak in the band".into(),
         ));
@@ -457,10 +591,43 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let line_to_forced_db = 10.0 * ((e_line + tiny) / (e_sync + floor * df)).log10();
     let line_to_floor_db = 10.0 * (psd[peak] / floor.max(tiny)).log10();
     let peak_hz = refine_peak_hz(&psd, peak, df);
-    let line_variation = line_variation(&signals.data, segment, peak);
-    let margin = (options.max_line_variation - line_variation)
-        .max(line_variation - options.min_burst_variation);
-    let chatter = margin >= 0.0 && line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
+    let second_half =
+        |bin: usize| line_variation(&signals.data, &stats, segment, bin, (n / 2, n), 4);
+    let variation = second_half(peak);
+    let margin = variation_margin(variation, options);
+    let whole = margin >= 0.0 && line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
+    let windowed = judge_windows(
+        &signals.data,
+        &stats,
+        &segment_psd,
+        &synchronous_bins,
+        (first, last),
+        fs,
+        options,
+    );
+    let flip = match options.teeth {
+        Some(teeth) if teeth >= 2 && teeth % 2 == 0 => {
+            flip_lines(&psd, floor, f0, teeth, (first, last), df, second_half).map(|mut f| {
+                f.variation_margin = options.max_line_variation - f.line_variation;
+                f.runout_margin_db = f.line_to_runout_db.map(|r| r - MIN_FLIP_TO_RUNOUT_DB);
+                f.chatter = f.variation_margin >= 0.0
+                    && f.runout_margin_db.is_some_and(|m| m >= 0.0)
+                    && f.line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
+                f
+            })
+        }
+        _ => None,
+    };
+    let chatter_hz = if whole {
+        Some(peak_hz)
+    } else {
+        windowed
+            .as_ref()
+            .and_then(|w| w.chatter.as_ref())
+            .map(|c| c.line_hz)
+            .or_else(|| flip.as_ref().filter(|f| f.chatter).map(|f| f.line_hz))
+    };
+    let chatter = chatter_hz.is_some();
     let harmonics_hz = (1..)
         .map(|k| k as f64 * f0)
         .skip_while(|f| *f < lo)
@@ -472,7 +639,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
         } else {
             Verdict::Stable
         },
-        chatter_hz: chatter.then_some(peak_hz),
+        chatter_hz,
         evidence: DetectionEvidence {
             fundamental_hz: f0,
             peak_hz,
@@ -483,8 +650,10 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
             min_burst_variation: options.min_burst_variation,
             margin,
             resolution_hz: df,
-            line_variation,
+            line_variation: variation,
             interference: comb,
+            windows: windowed,
+            flip,
         },
         spectrum: Spectrum {
             frequencies_hz: (0..psd.len()).map(|i| i as f64 * df).collect(),
@@ -525,23 +694,265 @@ fn refine_fundamental(psd: &[f64], df: f64, f0: f64, hi: f64, options: &Detectio
         .map_or(f0, |(f, _)| f)
 }
 
-/// Coefficient of variation of the line's share of the power over the record's second half
-/// (the line's power over the segment's power, so that a cut that deepens or leaves the
-/// workpiece changes neither): segments of
-/// half the spectrum's length (so the line, at bin `peak` of the spectrum, falls at bin
-/// peak / 2 of theirs), Hann windowed, hopped by a quarter of their length; the power is summed
-/// over the three bins around the line and over the standardized channels.
-fn line_variation(data: &[Vec<f64>], spectrum_segment: usize, peak: usize) -> f64 {
+/// The strongest line at an odd multiple of half the tooth-passing frequency, (2k + 1) z f_0 / 2,
+/// against the other spindle harmonics; `variation` gives the coefficient of variation of a bin's
+/// share of the power.
+fn flip_lines(
+    psd: &[f64],
+    floor: f64,
+    f0: f64,
+    teeth: usize,
+    (first, last): (usize, usize),
+    df: f64,
+    variation: impl Fn(usize) -> f64,
+) -> Option<FlipEvidence> {
+    let half = teeth / 2;
+    // the largest density within 2 bins of each spindle harmonic in the band
+    let mut flip: Option<(usize, usize)> = None; // (harmonic, bin)
+    let mut forced = 0.0f64;
+    let mut runout: Option<f64> = None;
+    let k_first = ((first as f64 * df / f0).ceil() as usize).max(1);
+    let k_last = (last as f64 * df / f0).floor() as usize;
+    for k in k_first..=k_last {
+        let centre = (k as f64 * f0 / df).round() as usize;
+        let bin = (centre.saturating_sub(2)..=(centre + 2).min(psd.len() - 1))
+            .max_by(|a, b| psd[*a].total_cmp(&psd[*b]))?;
+        let level = psd[bin];
+        if k % half == 0 && (k / half) % 2 == 1 {
+            if flip.is_none_or(|(_, b)| level > psd[b]) {
+                flip = Some((k, bin));
+            }
+        } else {
+            forced = forced.max(level);
+            if k % half != 0 {
+                runout = Some(runout.map_or(level, |r: f64| r.max(level)));
+            }
+        }
+    }
+    let (_, bin) = flip?;
+    let db = |a: f64, b: f64| 10.0 * (a / b.max(f64::MIN_POSITIVE)).log10();
+    Some(FlipEvidence {
+        line_hz: refine_peak_hz(psd, bin, df),
+        line_to_floor_db: db(psd[bin], floor),
+        line_to_forced_db: db(psd[bin], forced),
+        line_to_runout_db: runout.map(|r| db(psd[bin], r)),
+        line_variation: variation(bin),
+        variation_margin: f64::NAN,
+        runout_margin_db: None,
+        chatter: false,
+    })
+}
+
+/// Mean and 1 / standard deviation of a channel (0 for a constant channel).
+fn standardization(ch: &[f64]) -> (f64, f64) {
+    let n = ch.len() as f64;
+    let mean = ch.iter().sum::<f64>() / n;
+    let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+    (mean, if var > 0.0 { 1.0 / var.sqrt() } else { 0.0 })
+}
+
+/// Mean of densities (Welch's average of segment densities).
+fn mean_density(densities: &[Vec<f64>]) -> Vec<f64> {
+    let mut mean = vec![0.0; densities.first().map_or(0, Vec::len)];
+    for d in densities {
+        mean.iter_mut().zip(d).for_each(|(a, b)| *a += b);
+    }
+    let count = densities.len().max(1) as f64;
+    mean.iter_mut().for_each(|v| *v /= count);
+    mean
+}
+
+/// The floor (median density of the non-synchronous bins `first..=last`) and the strongest
+/// non-synchronous local maximum; `None` without one.
+fn floor_and_peak(
+    psd: &[f64],
+    synchronous: &[bool],
+    first: usize,
+    last: usize,
+) -> Option<(f64, usize)> {
+    let mut floor_values: Vec<f64> = (first..=last)
+        .filter(|i| !synchronous[*i])
+        .map(|i| psd[i])
+        .collect();
+    if floor_values.is_empty() {
+        return None;
+    }
+    let mid = floor_values.len() / 2;
+    let floor = *floor_values
+        .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
+        .1;
+    let peak = (first..=last)
+        .filter(|&i| !synchronous[i])
+        .filter(|&i| psd[i] >= psd[i - 1] && psd.get(i + 1).is_none_or(|v| psd[i] >= *v))
+        .max_by(|a, b| psd[*a].total_cmp(&psd[*b]))?;
+    Some((floor, peak))
+}
+
+/// The larger of (limit-cycle threshold - V) and (V - burst threshold): positive for chatter.
+fn variation_margin(variation: f64, options: &DetectionOptions) -> f64 {
+    (options.max_line_variation - variation).max(variation - options.min_burst_variation)
+}
+
+/// The record judged window by window (see the [module documentation](self#windows)): windows of
+/// [`WINDOW_SEGMENTS`] spectrum segments every half window, each judged like the whole record
+/// (its own density, floor and strongest non-synchronous line, the line's variation over all of
+/// the window's short segments); `None` when fewer than two windows fit.
+fn judge_windows(
+    data: &[Vec<f64>],
+    stats: &[(f64, f64)],
+    segment_psd: &[Vec<f64>],
+    synchronous: &[bool],
+    (first, last): (usize, usize),
+    fs: f64,
+    options: &DetectionOptions,
+) -> Option<WindowedEvidence> {
+    let bins = segment_psd.first()?.len();
+    let segment = 2 * (bins - 1);
+    let df = fs / segment as f64;
+    // in Welch segments (half a spectrum segment apart)
+    let per_window = 2 * WINDOW_SEGMENTS - 1;
+    let hop = WINDOW_SEGMENTS;
+    if segment_psd.len() < per_window + hop * (MIN_SUSTAINED_WINDOWS - 1) {
+        return None;
+    }
+    let count = (segment_psd.len() - per_window) / hop + 1;
+    let half = segment / 2;
+    // each window's line first (cheap: the densities are there)
+    let lines: Vec<Option<(usize, f64, f64)>> = (0..count)
+        .into_par_iter()
+        .map(|w| {
+            let psd = mean_density(&segment_psd[w * hop..w * hop + per_window]);
+            let (floor, peak) = floor_and_peak(&psd, synchronous, first, last)?;
+            let line_to_floor_db = 10.0 * (psd[peak] / floor.max(f64::MIN_POSITIVE)).log10();
+            Some((peak, refine_peak_hz(&psd, peak, df), line_to_floor_db))
+        })
+        .collect();
+    // the line's variation only where it can matter: the line stands out of the floor and a
+    // neighbouring window has it too
+    let stands = |w: usize| lines[w].filter(|l| l.2 >= MIN_LINE_TO_FLOOR_DB);
+    let paired = |a: usize, b: usize| {
+        stands(a)
+            .zip(stands(b))
+            .is_some_and(|(x, y)| (x.1 - y.1).abs() <= LINE_MATCH_BINS * df)
+    };
+    let judged: Vec<(WindowJudgement, usize)> = (0..count)
+        .into_par_iter()
+        .filter_map(|w| {
+            let (peak, line_hz, line_to_floor_db) = lines[w]?;
+            let start = w * hop * half;
+            let needed = (w > 0 && paired(w - 1, w)) || (w + 1 < count && paired(w, w + 1));
+            let variation = needed.then(|| {
+                line_variation(
+                    data,
+                    stats,
+                    segment,
+                    peak,
+                    (start, start + WINDOW_SEGMENTS * segment),
+                    WINDOW_HOPS_PER_SEGMENT,
+                )
+            });
+            Some((
+                WindowJudgement {
+                    start_s: start as f64 / fs,
+                    line_hz,
+                    line_to_floor_db,
+                    line_variation: variation,
+                    margin: variation.map(|v| variation_margin(v, options)),
+                },
+                w,
+            ))
+        })
+        .collect();
+    let window_s = (WINDOW_SEGMENTS * segment) as f64 / fs;
+    // neighbouring windows at the same line, both standing out of their floor
+    let same_line = |a: &(WindowJudgement, usize), b: &(WindowJudgement, usize)| {
+        b.1 == a.1 + 1
+            && (a.0.line_hz - b.0.line_hz).abs() <= LINE_MATCH_BINS * df
+            && a.0.margin.is_some()
+            && b.0.margin.is_some()
+    };
+    let margin = judged
+        .windows(2)
+        .filter(|p| same_line(&p[0], &p[1]))
+        .filter_map(|p| Some(p[0].0.margin?.min(p[1].0.margin?)))
+        .max_by(f64::total_cmp);
+    // runs of chattering windows at the same line
+    let chatters = |j: &(WindowJudgement, usize)| j.0.margin.is_some_and(|m| m >= 0.0);
+    let mut best: Option<(usize, f64, ChatterSpan)> = None;
+    let mut i = 0;
+    while i < judged.len() {
+        let mut end = i;
+        while chatters(&judged[i])
+            && end + 1 < judged.len()
+            && chatters(&judged[end + 1])
+            && same_line(&judged[end], &judged[end + 1])
+        {
+            end += 1;
+        }
+        let run = &judged[i..=end];
+        if chatters(&judged[i]) && run.len() >= MIN_SUSTAINED_WINDOWS {
+            let run_margin = run
+                .iter()
+                .filter_map(|j| j.0.margin)
+                .fold(f64::INFINITY, f64::min);
+            let strongest = run
+                .iter()
+                .max_by(|a, b| {
+                    a.0.margin
+                        .partial_cmp(&b.0.margin)
+                        .unwrap_or(std::cmp::Ordering::Equal)
+                })
+                .map(|j| &j.0)?;
+            let span = ChatterSpan {
+                start_s: run[0].0.start_s,
+                end_s: run[run.len() - 1].0.start_s + window_s,
+                line_hz: strongest.line_hz,
+                line_variation: strongest.line_variation.unwrap_or(f64::NAN),
+            };
+            let better = best.as_ref().is_none_or(|(len, m, _)| {
+                run.len() > *len || (run.len() == *len && run_margin > *m)
+            });
+            if better {
+                best = Some((run.len(), run_margin, span));
+            }
+        }
+        i = end + 1;
+    }
+    Some(WindowedEvidence {
+        window_s,
+        hop_s: window_s / 2.0,
+        min_duration_s: window_s * (1.0 + 0.5 * (MIN_SUSTAINED_WINDOWS - 1) as f64),
+        margin,
+        chatter: best.map(|(_, _, span)| span),
+        windows: judged.into_iter().map(|(j, _)| j).collect(),
+    })
+}
+
+/// Coefficient of variation of the line's share of the power over the samples `range` (the line's
+/// power over the segment's power, so that a cut that deepens or leaves the workpiece changes
+/// neither): segments of half the spectrum's length (so the line, at bin `peak` of the
+/// spectrum, falls at bin peak / 2 of theirs), Hann windowed, starting every
+/// 1 / `hops_per_segment` of their length (a quarter for the whole record) from the record's start, the ones wholly inside `range`; the power is summed over the
+/// three bins around the line and over the channels standardized by `stats` (mean, 1 / standard
+/// deviation).
+fn line_variation(
+    data: &[Vec<f64>],
+    stats: &[(f64, f64)],
+    spectrum_segment: usize,
+    peak: usize,
+    (from, to): (usize, usize),
+    hops_per_segment: usize,
+) -> f64 {
     let n = data[0].len();
     let segment = (spectrum_segment / 2).max(16);
-    let step = (segment / 4).max(1);
+    let step = (segment / hops_per_segment).max(1);
     let centre = (peak as f64 / 2.0).round() as usize;
     if n < segment {
         return f64::NAN;
     }
     let starts: Vec<usize> = (0..=(n - segment) / step)
         .map(|s| s * step)
-        .filter(|s| *s >= n / 2)
+        .filter(|s| *s >= from && s + segment <= to)
         .collect();
     let window: Vec<f64> = (0..segment)
         .map(|k| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / segment as f64).cos())
@@ -552,20 +963,12 @@ fn line_variation(data: &[Vec<f64>], spectrum_segment: usize, peak: usize) -> f6
             (w.cos(), w.sin())
         })
         .collect();
-    let stats: Vec<(f64, f64)> = data
-        .iter()
-        .map(|ch| {
-            let mean = ch.iter().sum::<f64>() / n as f64;
-            let var = ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-            (mean, if var > 0.0 { 1.0 / var.sqrt() } else { 0.0 })
-        })
-        .collect();
     let powers: Vec<f64> = starts
         .par_iter()
         .map(|&s| {
             let mut total = 0.0;
             let mut energy = 0.0;
-            for (ch, (mean, scale)) in data.iter().zip(&stats) {
+            for (ch, (mean, scale)) in data.iter().zip(stats) {
                 energy += ch[s..s + segment]
                     .iter()
                     .zip(&window)

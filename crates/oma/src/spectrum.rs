@@ -106,6 +106,32 @@ pub fn power_spectral_density(
     sample_rate_hz: f64,
     segment_len: usize,
 ) -> Result<Spectrum> {
+    let densities = segment_densities(x, sample_rate_hz, segment_len)?;
+    let mut values = vec![0.0; segment_len / 2 + 1];
+    for d in &densities {
+        for (a, b) in values.iter_mut().zip(d) {
+            *a += b;
+        }
+    }
+    let count = densities.len() as f64;
+    values.iter_mut().for_each(|v| *v /= count);
+    Ok(Spectrum {
+        frequencies_hz: (0..values.len())
+            .map(|k| k as f64 * sample_rate_hz / segment_len as f64)
+            .collect(),
+        values,
+    })
+}
+
+/// The one-sided density (units^2 / Hz) of each Hann segment of `segment_len` samples (>= 4, at
+/// most the record), the segments starting every `segment_len / 2` samples: the terms whose
+/// mean is Welch's estimate ([`power_spectral_density`]), kept apart so that the density of any
+/// run of consecutive segments (a stretch of the record) is their mean.
+pub fn segment_densities(
+    x: &[f64],
+    sample_rate_hz: f64,
+    segment_len: usize,
+) -> Result<Vec<Vec<f64>>> {
     if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
         return Err(OmaError::InvalidInput {
             field: "sample_rate_hz",
@@ -128,43 +154,35 @@ pub fn power_spectral_density(
     let bins = segment_len / 2 + 1;
     let step = segment_len / 2;
     let segments = (x.len() - segment_len) / step + 1;
-    let mut acc = vec![0.0; bins];
+    let power: f64 = window.iter().map(|w| w * w).sum();
+    let scale = 1.0 / (sample_rate_hz * power);
     let mut buf = vec![Complex64::new(0.0, 0.0); segment_len];
     let mut scratch = vec![Complex64::new(0.0, 0.0); fft.get_inplace_scratch_len()];
-    for s in 0..segments {
-        let start = s * step;
-        for ((b, v), w) in buf
-            .iter_mut()
-            .zip(&x[start..start + segment_len])
-            .zip(&window)
-        {
-            *b = Complex64::new(v * w, 0.0);
-        }
-        fft.process_with_scratch(&mut buf, &mut scratch);
-        for (a, b) in acc.iter_mut().zip(&buf) {
-            *a += b.norm_sqr();
-        }
-    }
-    let power: f64 = window.iter().map(|w| w * w).sum();
-    let scale = 1.0 / (sample_rate_hz * power * segments as f64);
-    let values = acc
-        .into_iter()
-        .enumerate()
-        .map(|(k, a)| {
-            let one_sided = if k == 0 || 2 * k == segment_len {
-                1.0
-            } else {
-                2.0
-            };
-            one_sided * scale * a
+    Ok((0..segments)
+        .map(|s| {
+            let start = s * step;
+            for ((b, v), w) in buf
+                .iter_mut()
+                .zip(&x[start..start + segment_len])
+                .zip(&window)
+            {
+                *b = Complex64::new(v * w, 0.0);
+            }
+            fft.process_with_scratch(&mut buf, &mut scratch);
+            buf[..bins]
+                .iter()
+                .enumerate()
+                .map(|(k, b)| {
+                    let one_sided = if k == 0 || 2 * k == segment_len {
+                        1.0
+                    } else {
+                        2.0
+                    };
+                    one_sided * scale * b.norm_sqr()
+                })
+                .collect()
         })
-        .collect();
-    Ok(Spectrum {
-        frequencies_hz: (0..bins)
-            .map(|k| k as f64 * sample_rate_hz / segment_len as f64)
-            .collect(),
-        values,
-    })
+        .collect())
 }
 
 /// Frequency (Hz) of the peak of a density `psd` (bins `df` apart) at its local maximum `i`,

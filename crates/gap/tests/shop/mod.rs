@@ -3,8 +3,9 @@
 //! [`campaign_plan`] is simulated in the time domain (`chatter_dynamics::simulate`: regenerative
 //! force with loss of contact, broadband and spindle-harmonic forcing) on the true machine,
 //! 10 % measurement noise is added, a cut is labelled stable or chatter with its chatter
-//! frequency by `chatter_oma::detection`, and the dominant pole of a pole test is identified
-//! from a long stable record by `chatter_oma::identify` (modified LSCE with the spindle
+//! frequency by `chatter_oma::detection` (told the tooth count, so that flip chatter counts),
+//! and the dominant pole of a pole test is identified from a long stable record by
+//! `chatter_oma::identify` (modified LSCE with the spindle
 //! harmonics imposed for turning; lifting at the tooth period and polyreference for milling, its
 //! principal frequency reported as `chatter oma` does). Nothing of the diagnosis's own
 //! prediction path (the characteristic roots or the full discretization) makes the data.
@@ -97,6 +98,11 @@ pub fn observe(nominal: &ModalModel, scenario: &Scenario, poles: bool) -> Observ
                 let options = DetectionOptions {
                     // finer than the default f0 / 10: the harmonics mask 5 bins each
                     resolution_hz: Some(f0 / 40.0),
+                    // flip chatter of an even-toothed cutter is judged with the tooth count
+                    teeth: match model.operation() {
+                        Operation::Milling(m) => Some(m.teeth()),
+                        _ => None,
+                    },
                     ..DetectionOptions::new(f0)
                 };
                 let d = detect(&signals, &options).unwrap();
