@@ -12,7 +12,7 @@
 //! speed the experimental limit b_exp is the midpoint between the deepest stable cut below the
 //! shallowest unstable cut and that unstable cut; C minimizes
 //! RSS(C) = sum over speeds (b_exp - b_lim(C))^2, b_lim the process-damped limiting depth
-//! ([`crate::boundary`]) capped at the tool's cutting-edge length.
+//! (`chatter_stability::prepared::SolverOptions`) capped at the tool's cutting-edge length.
 
 use crate::cuts::CutKernel;
 use crate::ensemble::BoundaryEnsemble;
