@@ -818,7 +818,10 @@ fn diagnose<'py>(
         if pointwise {
             entry.set_item("prior_draws", matrix(py, &c.posterior.prior_draws, width)?)?;
             let n = c.posterior.log_likelihood.first().map_or(0, Vec::len);
-            entry.set_item("log_likelihood", matrix(py, &c.posterior.log_likelihood, n)?)?;
+            entry.set_item(
+                "log_likelihood",
+                matrix(py, &c.posterior.log_likelihood, n)?,
+            )?;
         }
     }
     out.set_item(
