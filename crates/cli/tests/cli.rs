@@ -825,6 +825,23 @@ fn one_signal_observations(dir: &Path, file: &Path, fields: &str) -> PathBuf {
     obs
 }
 
+/// A model file in `dir` whose dynamics are the CutPro tool-tip FRFs (`measured_frf`, x and
+/// y) with the files' cutting coefficients, and the two FRF paths; None (test skipped) when the
+/// real data are absent.
+fn cutpro_measured_model(dir: &Path) -> Option<(PathBuf, PathBuf, PathBuf)> {
+    let x = real_data("cutpro_frf/General_FRFX.frf")?;
+    let y = real_data("cutpro_frf/General_FRFY.frf")?;
+    let path = dir.join("cutpro.json");
+    let model = serde_json::json!({
+        "operation": {"kind": "milling", "teeth": 2, "radial_immersion": 0.5,
+                      "direction": "down", "tool_diameter_mm": 31.75},
+        "cutting": {"kt_n_per_mm2": 1319.4, "kn_n_per_mm2": 788.8},
+        "measured_frf": [{"file": x, "direction": "x"}, {"file": y, "direction": "y"}]
+    });
+    std::fs::write(&path, model.to_string()).unwrap();
+    Some((path, x, y))
+}
+
 fn real_data(path: &str) -> Option<PathBuf> {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -954,21 +971,10 @@ fn lobe_depths(csv: &str) -> Vec<f64> {
 /// library test). The same file refuses FDM with the method and mode named.
 #[test]
 fn fit_frf_complex_modes_reproduce_the_cutpro_lobes() {
-    let (Some(x), Some(y)) = (
-        real_data("cutpro_frf/General_FRFX.frf"),
-        real_data("cutpro_frf/General_FRFY.frf"),
-    ) else {
+    let dir = tempfile::tempdir().unwrap();
+    let Some((base, x, y)) = cutpro_measured_model(dir.path()) else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let base = dir.path().join("cutpro.json");
-    let model = serde_json::json!({
-        "operation": {"kind": "milling", "teeth": 2, "radial_immersion": 0.5,
-                      "direction": "down", "tool_diameter_mm": 31.75},
-        "cutting": {"kt_n_per_mm2": 1319.4, "kn_n_per_mm2": 788.8},
-        "measured_frf": [{"file": x, "direction": "x"}, {"file": y, "direction": "y"}]
-    });
-    std::fs::write(&base, model.to_string()).unwrap();
     let (fit_x, fit_xy) = (dir.path().join("x.json"), dir.path().join("xy.json"));
     for (frf, direction, from, to) in [(&x, "x", &base, &fit_x), (&y, "y", &fit_x, &fit_xy)] {
         let report = succeed(
@@ -1054,21 +1060,10 @@ fn fit_frf_complex_modes_reproduce_the_cutpro_lobes() {
 /// digits); bad uses are refused.
 #[test]
 fn bands_on_measured_frf_with_offsets_from_the_frf_uncertainty() {
-    let (Some(x), Some(y)) = (
-        real_data("cutpro_frf/General_FRFX.frf"),
-        real_data("cutpro_frf/General_FRFY.frf"),
-    ) else {
+    let dir = tempfile::tempdir().unwrap();
+    let Some((model, _, _)) = cutpro_measured_model(dir.path()) else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("cutpro.json");
-    let text = serde_json::json!({
-        "operation": {"kind": "milling", "teeth": 2, "radial_immersion": 0.5,
-                      "direction": "down", "tool_diameter_mm": 31.75},
-        "cutting": {"kt_n_per_mm2": 1319.4, "kn_n_per_mm2": 788.8},
-        "measured_frf": [{"file": x, "direction": "x"}, {"file": y, "direction": "y"}]
-    });
-    std::fs::write(&model, text.to_string()).unwrap();
     let speeds = ["--speeds", "4500:7500:121"];
     let stated = succeed(
         chatter()

@@ -16,7 +16,6 @@
 
 #![allow(clippy::unwrap_used)]
 
-use chatter_bayes::prior::{IndependentPrior, Marginal};
 use chatter_dynamics::{Cut, ModalModel, examples};
 use chatter_progress::Silent;
 use chatter_stability::boundary;
@@ -25,7 +24,7 @@ use chatter_stability::prepared::Method;
 use chatter_stability::prepared::SolverOptions;
 use chatter_updating::cuts::CutKernel;
 use chatter_updating::ensemble::BoundaryEnsemble;
-use chatter_updating::parameters::{Parameterization, parse_model_parameters};
+use chatter_updating::parameters::Parameterization;
 use std::collections::BTreeMap;
 
 const TRUE_C: f64 = 2.5e5;
@@ -76,26 +75,9 @@ impl Machine {
 }
 
 fn prior_paths(speeds: &[f64], method: Method) -> BoundaryEnsemble {
-    let p = Parameterization::new(
-        flexure(),
-        parse_model_parameters("kt_n_per_mm2,kn_n_per_mm2,c_n_per_m").unwrap(),
-    )
-    .unwrap();
-    let prior = IndependentPrior::new(vec![
-        Marginal::Normal {
-            mean: 2111.2,
-            sd: 78.3,
-        },
-        Marginal::Normal {
-            mean: 1052.6,
-            sd: 27.9,
-        },
-        Marginal::Uniform {
-            low: 0.5e5,
-            high: 10e5,
-        },
-    ])
-    .unwrap();
+    // 003's prior on kt, kn and C (the paper's, as `chatter_updating::karandikar` holds it)
+    let (parameters, prior) = chatter_updating::karandikar::prior().unwrap();
+    let p = Parameterization::new(flexure(), parameters).unwrap();
     let options = SolverOptions::new(method).with_max_depth_m(7.5e-3);
     BoundaryEnsemble::from_prior(p, &prior, PATHS, speeds, options, 11, &Silent).unwrap()
 }
