@@ -780,6 +780,7 @@ fn validation_of(validation: &str, folds: usize) -> PyResult<chatter_gap::Valida
 /// `residuals`, ...) plus `diagnosed_model`.
 #[pyfunction]
 #[pyo3(signature = (model, observations, seed, samples=120, validation="kfold", folds=3, pointwise=true))]
+#[allow(clippy::too_many_arguments)]
 fn diagnose<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
