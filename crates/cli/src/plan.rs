@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use chatter_jobs::plan::PlanRequest;
 
 use chatter_updating::parameters::parse_model_parameters;
-use chatter_updating::plan::Strategy;
+use chatter_updating::plan::{SampledBoundaries, Strategy};
 use chatter_updating::update::PriorOverrides;
 use std::path::PathBuf;
 
@@ -74,12 +74,61 @@ pub struct PlanArgs {
     /// One self-contained HTML page: inputs, plots, numbers, next test, warnings.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// The probability of stability after the cuts as CSV `speed_rpm,depth_mm,p_stable`, on
+    /// the sampled speeds and the --depths grid (default: 60 depths up to 1.2 times the
+    /// deepest sampled limit).
+    #[arg(long)]
+    map_out: Option<PathBuf>,
+    /// The sampled boundaries as CSV `path,probability,speed_rpm,depth_mm` (one row per path
+    /// and speed; depth empty where the path has no boundary below the depth ceiling).
+    #[arg(long)]
+    boundaries_out: Option<PathBuf>,
+}
+
+/// `--map-out`: P_s on the sampled speeds x `depths_mm` (or a default grid).
+fn map_csv(b: &SampledBoundaries, depths_mm: Option<&[f64]>) -> String {
+    let deepest_mm = b
+        .depths_m
+        .iter()
+        .flatten()
+        .filter(|d| d.is_finite())
+        .fold(0.0f64, |a, d| a.max(d * 1e3));
+    let default: Vec<f64> = (1..=60)
+        .map(|i| 1.2 * deepest_mm.max(1e-3) * i as f64 / 60.0)
+        .collect();
+    let depths = depths_mm.unwrap_or(&default);
+    let mut csv = String::from("speed_rpm,depth_mm,p_stable\n");
+    for (k, s) in b.speeds_rpm.iter().enumerate() {
+        for d in depths {
+            let p = b.probability_of_stability(k, d * 1e-3);
+            csv += &format!("{s},{d},{p}\n");
+        }
+    }
+    csv
+}
+
+/// `--boundaries-out`: every path's limiting depth at every sampled speed.
+fn boundaries_csv(b: &SampledBoundaries) -> String {
+    let mut csv = String::from("path,probability,speed_rpm,depth_mm\n");
+    for (i, (p, row)) in b.probabilities.iter().zip(&b.depths_m).enumerate() {
+        for (s, d) in b.speeds_rpm.iter().zip(row) {
+            let depth = if d.is_finite() {
+                format!("{}", d * 1e3)
+            } else {
+                String::new()
+            };
+            csv += &format!("{i},{p},{s},{depth}\n");
+        }
+    }
+    csv
 }
 
 /// Run `chatter plan`: print the next cut as JSON on stdout.
 pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     use crate::validate;
     crate::output::check_optional_file("--report", args.report.as_deref())?;
+    crate::output::check_optional_file("--map-out", args.map_out.as_deref())?;
+    crate::output::check_optional_file("--boundaries-out", args.boundaries_out.as_deref())?;
     let voi = args.strategy == StrategyArg::Voi;
     validate::unused(
         voi && args.p_test.is_some(),
@@ -184,6 +233,13 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
         StrategyArg::Voi => "voi",
         StrategyArg::Mrr => "mrr",
     };
+    if let Some(path) = &args.map_out {
+        let csv = map_csv(&outcome.boundaries, request.depths_mm.as_deref());
+        crate::output::write_atomic(path, csv.as_bytes())?;
+    }
+    if let Some(path) = &args.boundaries_out {
+        crate::output::write_atomic(path, boundaries_csv(&outcome.boundaries).as_bytes())?;
+    }
     let mut json = serde_json::to_value(&outcome)?;
     if let Some(map) = json.as_object_mut() {
         map.insert("strategy".into(), strategy.into());

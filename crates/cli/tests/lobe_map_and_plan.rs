@@ -83,10 +83,12 @@ fn lobes_write_a_modulus_map_consistent_with_the_limits() {
     assert!(!ok && err.contains("--depths"), "{err}");
 }
 
-/// Before any cut, value of information plans from the prior paths of 003's flexure; a
-/// frequency width is refused with value of information (003's likelihood has none).
+/// Before any cut, value of information plans from the prior paths of 003's flexure and writes
+/// the P_s map and the sampled boundaries; a frequency width is refused with value of information (003's likelihood has none).
 #[test]
 fn plan_the_first_cut_from_the_prior() {
+    let dir = tempfile::tempdir().unwrap();
+    let (map_path, boundaries_path) = (dir.path().join("map.csv"), dir.path().join("paths.csv"));
     let (ok, out, err) = run(chatter()
         .args([
             "plan",
@@ -105,10 +107,50 @@ fn plan_the_first_cut_from_the_prior() {
             "0.5:7.5:15",
             "--sigma-depth-mm",
             "0.25",
-        ]));
+            "--map-out",
+        ])
+        .arg(&map_path)
+        .arg("--boundaries-out")
+        .arg(&boundaries_path));
     assert!(ok, "{err}");
     let plan: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(plan["cuts_used"], 0);
+    // the P_s map, recomputed from the exported boundaries: the probability of the paths whose
+    // limit lies above the depth (empty depth: no boundary below the ceiling), non-increasing
+    // in depth, on the 5 speeds x 15 depths asked
+    let rows = |path: &std::path::Path| -> Vec<Vec<String>> {
+        std::fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect()
+    };
+    let number = |s: &str| -> f64 { s.parse().unwrap_or(f64::INFINITY) };
+    let boundaries = rows(&boundaries_path);
+    assert_eq!(boundaries.len(), 30 * 5);
+    let total: f64 = boundaries
+        .iter()
+        .filter(|r| r[2] == boundaries[0][2])
+        .map(|r| number(&r[1]))
+        .sum();
+    assert!((total - 1.0).abs() < 1e-9, "{total}");
+    let map = rows(&map_path);
+    assert_eq!(map.len(), 5 * 15);
+    let mut last = (String::new(), f64::INFINITY);
+    for r in &map {
+        let (depth_mm, p) = (number(&r[1]), number(&r[2]));
+        let recomputed: f64 = boundaries
+            .iter()
+            .filter(|b| b[2] == r[0] && depth_mm < number(&b[3]))
+            .map(|b| number(&b[1]))
+            .sum();
+        assert!((p - recomputed).abs() < 1e-9, "{r:?}: {recomputed}");
+        if r[0] == last.0 {
+            assert!(p <= last.1 + 1e-12, "P_s rises with depth at {r:?}");
+        }
+        last = (r[0].clone(), p);
+    }
     assert!(
         plan["next_cut"]["expected_reduction_percent"]
             .as_f64()

@@ -319,6 +319,15 @@ impl BoundaryEnsemble {
         self.columns.iter().map(|c| c.speed_rpm).collect()
     }
 
+    /// Every path's limiting depth (m) at the grid's speeds ([`Self::speeds_rpm`]): one row per
+    /// path, in the order of [`Self::probabilities`]; infinite where the path has no boundary
+    /// below the depth ceiling.
+    pub fn path_depths_m(&self) -> Vec<Vec<f64>> {
+        (0..self.samples.len())
+            .map(|i| self.columns.iter().map(|c| c.points[i].depth_m).collect())
+            .collect()
+    }
+
     /// Path probabilities P_i (sum 1).
     pub fn probabilities(&self) -> Vec<f64> {
         normalized_weights(&self.ln_weights)
@@ -568,9 +577,15 @@ fn contour_depth(p: &[f64], column: &Column, p_test: f64) -> Option<f64> {
 }
 
 fn stable_probability(p: &[f64], column: &Column, depth_m: f64) -> f64 {
+    stable_share(p, column.points.iter().map(|pt| pt.depth_m), depth_m)
+}
+
+/// The probability of the paths (probabilities `p`) whose limiting depth `limits_m` lies above
+/// `depth_m`: P_s of 003 Eq. 7 / 004 Eq. 8.
+pub(crate) fn stable_share(p: &[f64], limits_m: impl Iterator<Item = f64>, depth_m: f64) -> f64 {
     p.iter()
-        .zip(&column.points)
-        .filter(|(_, pt)| depth_m < pt.depth_m)
+        .zip(limits_m)
+        .filter(|(_, limit)| depth_m < *limit)
         .map(|(w, _)| w)
         .sum::<f64>()
         .clamp(0.0, 1.0)

@@ -105,6 +105,33 @@ pub struct PlanOutcome {
     pub best_stable_mrr_cm3_per_min: Option<f64>,
     /// Kish effective number of samples after the updates.
     pub effective_samples: f64,
+    /// The sampled boundaries after the updates (written as CSV by `chatter plan
+    /// --boundaries-out`; not in the JSON).
+    #[serde(skip)]
+    pub boundaries: SampledBoundaries,
+}
+
+/// The weighted sampled stability boundaries of a plan: P_s(speed, depth) is the probability of
+/// the paths whose limiting depth at that speed lies above the depth (003 Eq. 7, 004 Eq. 8).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SampledBoundaries {
+    /// The speeds of the grid (rpm).
+    pub speeds_rpm: Vec<f64>,
+    /// Path probabilities (sum 1).
+    pub probabilities: Vec<f64>,
+    /// Each path's limiting depth (m) at every speed (infinite: no boundary below the ceiling).
+    pub depths_m: Vec<Vec<f64>>,
+}
+
+impl SampledBoundaries {
+    /// P_s at speed index `k` and depth `depth_m`.
+    pub fn probability_of_stability(&self, k: usize, depth_m: f64) -> f64 {
+        crate::ensemble::stable_share(
+            &self.probabilities,
+            self.depths_m.iter().map(|d| d[k]),
+            depth_m,
+        )
+    }
 }
 
 /// Candidate speeds and depths when the settings give none. With cuts: the cut speeds +- 25 %
@@ -318,6 +345,11 @@ pub fn plan_next_cut(
         posterior_sd: moments.iter().map(|m| m.1).collect(),
         best_stable_mrr_cm3_per_min: best_stable,
         effective_samples: ensemble.effective_sample_size(),
+        boundaries: SampledBoundaries {
+            speeds_rpm: ensemble.speeds_rpm(),
+            probabilities: ensemble.probabilities(),
+            depths_m: ensemble.path_depths_m(),
+        },
     })
 }
 
