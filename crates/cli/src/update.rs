@@ -132,7 +132,7 @@ fn parse_classes(spec: &str) -> Result<Vec<f64>> {
 
 /// Run `chatter update`.
 pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
-    let folder = Folder::new("--out", &args.out, &FILES)?;
+    let mut folder = Folder::new("--out", &args.out, &FILES)?;
     crate::output::check_optional_file("--report", args.report.as_deref())?;
     crate::validate::count(
         "--samples",
@@ -223,7 +223,6 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     for p in &result.prior_bound_pileups {
         eprintln!("warning: {}", crate::report::jobs::pileup_warning(p));
     }
-    let mut folder = folder;
     if args.netcdf {
         let samples = result.samples.samples();
         let pointwise = job
