@@ -4,11 +4,15 @@
 //! turning) and over a 200-speed lobe diagram; the same FDM lobe diagram by the prepared solver
 //! (boundary search from the zero-order limit, warm-started Arnoldi), and at the automatic
 //! resolution (`Method::Fdm`: extrapolated from m and 2m steps); the multiplier of the 003-type
-//! flexure at 300 rpm with process damping (clustered multipliers, operator dimension 276).
+//! flexure at 300 rpm with process damping (clustered multipliers, operator dimension 276); the
+//! characteristic roots of turning (the gap diagnosis's turning likelihood) with the seed-000
+//! lathe's two modes and with a third mode (the `extra_mode` class: the LU path of Newton's step).
 use chatter_dynamics::examples;
+use chatter_dynamics::{Mode, ModeShape};
 use chatter_progress::Silent;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, lobe_diagram, speed_range};
+use chatter_stability::frequency_domain::dominant_and_unstable_poles;
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::prepared::{Method, PreparedDiscretization, PreparedSolver};
 use chatter_stability::zero_order::{zoa_limiting_depth, zoa_lobes};
@@ -78,5 +82,22 @@ fn zero_order(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, zero_order);
+fn characteristic_roots(c: &mut Criterion) {
+    let lathe = examples::ahmadi_2022_turning();
+    let mut modes = lathe.modes().to_vec();
+    let amplitude = 2.0 * std::f64::consts::PI * 1000.0 / 3e7f64.sqrt();
+    let shape = ModeShape::MassNormalized([amplitude * 0.6, amplitude * 0.8]);
+    modes.extend(Mode::new(1000.0, 0.03, shape));
+    let three = lathe.with_modes(modes).unwrap_or_else(|_| lathe.clone());
+    let mut group = c.benchmark_group("characteristic");
+    group.sample_size(20);
+    for (name, model) in [("two_modes", &lathe), ("three_modes", &three)] {
+        group.bench_function(format!("dominant_and_unstable_poles_2000rpm_{name}"), |b| {
+            b.iter(|| dominant_and_unstable_poles(model, black_box(2000.0), 1.0e-3))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, zero_order, characteristic_roots);
 criterion_main!(benches);

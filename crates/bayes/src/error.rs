@@ -11,7 +11,11 @@ pub enum BayesError {
         /// What was expected.
         message: String,
     },
-    /// The sampler could not proceed (e.g. every likelihood is zero).
+    /// The likelihood is zero (or its computation failed) at every draw from the prior: the
+    /// data rule out the prior's support, or nothing could be evaluated.
+    #[error("the likelihood is zero at every prior sample")]
+    ZeroLikelihood,
+    /// The sampler could not proceed (a singular covariance, no end of the tempering).
     #[error("{0}")]
     Degenerate(String),
 }

@@ -6,6 +6,7 @@
 //! | [`prior`] | uniform, normal, truncated normal, lognormal marginals; independent joints; the correlated multivariate normal (from mean and covariance or from samples) | |
 //! | [`samples`] | weighted sample sets: mean, covariance, quantiles, effective sample size | |
 //! | [`tmcmc`] | TMCMC / iTMCMC with the log-evidence ln p(D), data fit and information gain, model-class probabilities | Ching and Chen 2007; Betz, Papaioannou and Straub 2016; 000 Eq. 32-33 |
+//! | [`strata`] | stratified TMCMC: one run per slice of a uniform coordinate, pooled by total probability (for posteriors with separated modes along it) | |
 //! | [`rejection`] | rejection sampling: keep theta with probability L / L_max | 004 Section 4-5 |
 //! | [`amcmc`] | parallel adaptive MCMC with j candidates and k draws from the Eq. 8 stationary distribution, until s unique samples | 004 Section 5, Eq. 8 |
 //! | [`special`] | log-sum-exp, log-mean-exp and normalized log weights; the standard normal distribution function and its inverse | Numerical Recipes erfcc; Acklam |
@@ -59,6 +60,7 @@ pub mod prior;
 pub mod rejection;
 pub mod samples;
 pub mod special;
+pub mod strata;
 pub mod tmcmc;
 
 pub use error::{BayesError, Result};

@@ -192,9 +192,7 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         .map(|t| counted_ln_likelihood(likelihood, t, &failures))
         .collect();
     if ln_l.iter().all(|l| !l.is_finite()) {
-        return Err(BayesError::Degenerate(
-            "the likelihood is zero at every prior sample".into(),
-        ));
+        return Err(BayesError::ZeroLikelihood);
     }
     let mut beta = 0.0;
     let mut betas = vec![0.0];

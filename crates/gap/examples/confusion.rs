@@ -7,7 +7,8 @@
 //!
 //! `cargo run --release -p chatter-gap --example confusion [-- --machines 0,1 --seeds 2 --first-seed 0 --magnitudes 1
 //! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --sampler-offset 0
-//! --verbose]`
+//! --fit parameter_error,extra_mode --verbose]`; `--fit` limits the classes the diagnosis tries
+//! (all by default).
 
 mod common;
 
@@ -91,6 +92,7 @@ fn main() -> chatter_gap::Result<()> {
         steps: arg("--steps")
             .and_then(|s| s.parse().ok())
             .unwrap_or(defaults.steps),
+        classes: list("--fit", defaults.classes.clone()),
         ..defaults
     };
     // (machine, magnitude label) -> (right, total)

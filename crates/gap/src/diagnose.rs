@@ -12,6 +12,7 @@ use crate::shrink::{Shrink, ValidationReport, shrink};
 use crate::variant::Variant;
 use chatter_bayes::Prior;
 use chatter_bayes::special::log_sum_exp;
+use chatter_bayes::strata::{stratified_tmcmc, uniform_strata};
 use chatter_bayes::tmcmc::{
     TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, rejuvenate, tmcmc,
 };
@@ -33,7 +34,7 @@ pub(crate) const PREDICTIVE_SAMPLES: usize = 100;
 pub struct DiagnoseOptions {
     /// Seed of every random choice (samplers, folds, replications).
     pub seed: u64,
-    /// iTMCMC samples per class, times the class's [`EffectClass::population_factor`].
+    /// iTMCMC samples per class (per stratum for a class with [`EffectClass::strata`]).
     pub samples: usize,
     /// Metropolis-Hastings steps per chain and stage.
     pub steps: usize,
@@ -61,8 +62,8 @@ pub struct DiagnoseOptions {
     pub polish_rounds: usize,
     /// Held-out validation of the gap's shrinkage.
     pub validation: Validation,
-    /// iTMCMC samples per class and fold of the validation, times the class's
-    /// [`EffectClass::population_factor`].
+    /// iTMCMC samples per class and fold of the validation (per stratum for a class with
+    /// [`EffectClass::strata`]).
     pub validation_samples: usize,
     /// The candidate classes (`parameter_error` is always added).
     pub classes: Vec<EffectClass>,
@@ -323,13 +324,11 @@ impl Fitted<'_> {
     }
 
     /// The variant at the posterior mean of the sampled parameters (log factors, effect
-    /// parameters).
+    /// parameters) in the dominant posterior mode ([`ClassModel::posterior_mean`]).
     pub fn mean_variant(&self) -> Option<Variant> {
-        let s = self.run.samples.samples();
-        let n = s.first()?.len();
-        let mean: Vec<f64> = (0..n)
-            .map(|k| s.iter().map(|t| t[k]).sum::<f64>() / s.len() as f64)
-            .collect();
+        let mean = self
+            .model
+            .posterior_mean(self.run.samples.samples(), &self.run.ln_likelihoods)?;
         self.model.variant(&mean)
     }
 }
@@ -368,16 +367,21 @@ pub(crate) fn fit<'a>(
     seed: u64,
 ) -> Result<Fitted<'a>> {
     let model = ClassModel::new(class, nominal)?;
-    let samples = (samples as f64 * class.population_factor()).round() as usize;
     let count = FailureCount::default();
     let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta, &count);
-    let run =
-        tmcmc(&model.prior, &like, &options.tmcmc(samples, seed), &Silent).map_err(|source| {
-            GapError::Sampler {
-                class: class.name(),
-                source,
-            }
-        })?;
+    let tmcmc_options = TmcmcOptions {
+        steps: class.steps(options.steps),
+        ..options.tmcmc(samples, seed)
+    };
+    let run = match class.strata() {
+        None => tmcmc(&model.prior, &like, &tmcmc_options, &Silent),
+        Some((coordinate, slices)) => uniform_strata(&model.prior, coordinate, slices)
+            .and_then(|strata| stratified_tmcmc(&strata, &like, &tmcmc_options, &Silent)),
+    }
+    .map_err(|source| GapError::Sampler {
+        class: class.name(),
+        source,
+    })?;
     let (evaluations, failures) = count.get();
     Ok(Fitted {
         model,
