@@ -11,7 +11,8 @@
 
 #![allow(clippy::unwrap_used)]
 
-use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_bayes::prior::Marginal;
+use chatter_updating::joint_prior::SampledPrior;
 use chatter_dynamics::{
     Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
 };
@@ -83,7 +84,9 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
         })
         .fold(0.0, f64::max);
 
-    let prior = IndependentPrior::new(vec![
+    let prior = SampledPrior::new(
+        p.clone(),
+        vec![
         Marginal::Normal {
             mean: 700.0,
             sd: 70.0,
@@ -100,7 +103,10 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
             low: -0.05,
             high: 0.05,
         },
-    ])
+        ],
+        &Default::default(),
+        None,
+    )
     .unwrap();
     let options = SolverOptions::default().with_max_depth_m(10e-3);
     let mut samples =
