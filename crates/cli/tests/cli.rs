@@ -715,13 +715,29 @@ fn plan_prints_the_next_cut() {
 fn plan_takes_the_004_correlated_prior() {
     let plan = |extra: &[&str]| {
         let mut c = chatter();
-        c.args(["plan", "--quiet", "--strategy", "mrr", "--method", "zoa", "--paths", "60"])
-            .args(["--speeds", "8000:16000:21", "--depths", "0.1:6:60", "--p-test", "0.25"])
-            .arg("--model")
-            .arg(example("schmitz2022_rcsa_model.json"))
-            .arg("--priors")
-            .arg(example("schmitz2022_rcsa_prior.json"))
-            .args(extra);
+        c.args([
+            "plan",
+            "--quiet",
+            "--strategy",
+            "mrr",
+            "--method",
+            "zoa",
+            "--paths",
+            "60",
+        ])
+        .args([
+            "--speeds",
+            "8000:16000:21",
+            "--depths",
+            "0.1:6:60",
+            "--p-test",
+            "0.25",
+        ])
+        .arg("--model")
+        .arg(example("schmitz2022_rcsa_model.json"))
+        .arg("--priors")
+        .arg(example("schmitz2022_rcsa_prior.json"))
+        .args(extra);
         c
     };
     let plan_json: serde_json::Value = serde_json::from_str(&succeed(&mut plan(&[]))).unwrap();
@@ -730,7 +746,10 @@ fn plan_takes_the_004_correlated_prior() {
     let p = plan_json["next_cut"]["p_stable"].as_f64().unwrap();
     assert!((p - 0.25).abs() <= 0.05, "{p}");
     let err = fail(&mut plan(&["--parameters", "kt_n_per_mm2,kn_n_per_mm2"]));
-    assert!(err.contains("ks_n_per_mm2") && err.contains("not a sampled parameter"), "{err}");
+    assert!(
+        err.contains("ks_n_per_mm2") && err.contains("not a sampled parameter"),
+        "{err}"
+    );
 }
 
 /// `chatter oma` on a small signal file: a seeded 800 Hz mode (zeta 2 %) on two channels plus a
@@ -1082,7 +1101,14 @@ fn fit_frf_complex_modes_reproduce_the_cutpro_lobes() {
             .arg("fit-frf")
             .arg("--frf")
             .arg(&x)
-            .args(["--fmin-hz", "100", "--fmax-hz", "3000", "--mode-form", "real"])
+            .args([
+                "--fmin-hz",
+                "100",
+                "--fmax-hz",
+                "3000",
+                "--mode-form",
+                "real",
+            ])
             .arg("--with-residuals")
             .arg("--out")
             .arg(dir.path().join("never.json")),

@@ -171,12 +171,24 @@ mod tests {
             assert_eq!(model.receptance(f, 0, 1), bare.receptance(f, 0, 1));
         }
         // without a lower term the static receptance stays finite
-        assert!(bare.with_residuals([Default::default(), model.residuals()[1]]).unwrap().receptance(0.0, 1, 1).re.is_finite());
+        assert!(
+            bare.with_residuals([Default::default(), model.residuals()[1]])
+                .unwrap()
+                .receptance(0.0, 1, 1)
+                .re
+                .is_finite()
+        );
         let back = crate::ModalModel::from_json_str(&model.to_json_string(), path).unwrap();
         assert_eq!(back.residuals(), model.residuals());
-        assert_eq!(back.with_modes(back.modes().to_vec()).unwrap().residuals(), model.residuals());
+        assert_eq!(
+            back.with_modes(back.modes().to_vec()).unwrap().residuals(),
+            model.residuals()
+        );
         for (entry, needle) in [
-            (r#"{"direction": "z", "upper_m_per_n": 1e-8}"#, "residuals[0].direction"),
+            (
+                r#"{"direction": "z", "upper_m_per_n": 1e-8}"#,
+                "residuals[0].direction",
+            ),
             (r#"{"direction": "x"}, {"direction": "x"}"#, "twice"),
             (r#"{"direction": "x", "lower_kg": 1}"#, "lower_kg"),
         ] {

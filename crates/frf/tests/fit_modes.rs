@@ -218,7 +218,9 @@ fn model_file_with_residual_terms(frf: &Frf, fit: &chatter_frf::ModalFit) {
     let path = std::path::Path::new("tap.json");
     let with = ModalModel::from_json_str(&text, path).unwrap();
     let back = ModalModel::from_json_str(&with.to_json_string(), path).unwrap();
-    assert_eq!(back.residuals(), with.residuals());
+    let (a, b) = (back.residuals()[0], with.residuals()[0]);
+    assert!((a.upper_m_per_n / b.upper_m_per_n - 1.0).abs() < 1e-12);
+    assert!((a.lower_per_kg / b.lower_per_kg - 1.0).abs() < 1e-12);
     let alone = with.with_residuals(Default::default()).unwrap();
     let (lo, hi) = (250.0, 4000.0);
     let m_with = frf
@@ -281,5 +283,8 @@ fn model_file_with_residual_terms(frf: &Frf, fit: &chatter_frf::ModalFit) {
     eprintln!(
         "tap-test lobes vs the measured FRF's: with residuals {w_with:.4} worst, {min_with:.4} at the minimum; complex modes alone {w_alone:.4}, {min_alone:.4}"
     );
-    assert!(min_with < min_alone && min_with < 0.05, "{min_with} {min_alone}");
+    assert!(
+        min_with < min_alone && min_with < 0.05,
+        "{min_with} {min_alone}"
+    );
 }

@@ -219,15 +219,13 @@ impl BoundaryEnsemble {
             other => other?,
         };
         let set = &posterior.samples;
-        let samples = set.samples().iter().map(|z| prior.from_whitened(z)).collect();
+        let samples = set
+            .samples()
+            .iter()
+            .map(|z| prior.from_whitened(z))
+            .collect();
         let set = SampleSet::new(samples, set.weights().to_vec())?;
-        Self::from_sample_set(
-            parameterization,
-            &set,
-            speeds_rpm,
-            options,
-            observer,
-        )
+        Self::from_sample_set(parameterization, &set, speeds_rpm, options, observer)
     }
 
     /// `paths` samples drawn from `prior` (path i from its own stream of `seed`).

@@ -23,8 +23,8 @@ use crate::error::{Result, UpdatingError};
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::update::PriorOverrides;
 use chatter_bayes::Prior;
-use chatter_bayes::tmcmc::{LikelihoodFailure, LogLikelihood};
 use chatter_bayes::prior::{Marginal, MultivariateNormalPrior};
+use chatter_bayes::tmcmc::{LikelihoodFailure, LogLikelihood};
 
 /// Draws of a truncated prior tried before giving up (the last one is then returned, and the
 /// model built from it fails with its own error message).
@@ -121,13 +121,12 @@ impl SampledPrior {
     ) -> Result<Self> {
         let names = parameterization.names();
         for (name, spec) in overrides {
-            let k = names
-                .iter()
-                .position(|n| n == name)
-                .ok_or_else(|| UpdatingError::InvalidInput {
+            let k = names.iter().position(|n| n == name).ok_or_else(|| {
+                UpdatingError::InvalidInput {
                     field: "priors",
                     message: format!("`{name}` is not a sampled parameter ({})", names.join(", ")),
-                })?;
+                }
+            })?;
             marginals[k] = spec.validated()?;
         }
         let block = match joint {
@@ -184,7 +183,10 @@ impl SampledPrior {
         if let (Some((positions, normal)), Some((l, _))) = (&self.block, &self.whitening) {
             let r = nalgebra::DVector::from_iterator(
                 positions.len(),
-                positions.iter().zip(normal.mean()).map(|(&k, m)| theta[k] - m),
+                positions
+                    .iter()
+                    .zip(normal.mean())
+                    .map(|(&k, m)| theta[k] - m),
             );
             if let Some(w) = l.solve_lower_triangular(&r) {
                 for (&k, v) in positions.iter().zip(w.iter()) {
@@ -199,7 +201,8 @@ impl SampledPrior {
     pub fn from_whitened(&self, z: &[f64]) -> Vec<f64> {
         let mut theta = z.to_vec();
         if let (Some((positions, normal)), Some((l, _))) = (&self.block, &self.whitening) {
-            let w = nalgebra::DVector::from_iterator(positions.len(), positions.iter().map(|&k| z[k]));
+            let w =
+                nalgebra::DVector::from_iterator(positions.len(), positions.iter().map(|&k| z[k]));
             let u = l * w;
             for ((&k, v), m) in positions.iter().zip(u.iter()).zip(normal.mean()) {
                 theta[k] = m + v;
@@ -307,7 +310,10 @@ mod tests {
         JointNormal {
             parameter_names: vec!["ks_n_per_mm2".into(), "fn1_hz".into()],
             mean: vec![750.0, 750.0],
-            covariance: vec![vec![75.0f64.powi(2), 0.5 * 75.0 * 15.0], vec![0.5 * 75.0 * 15.0, 225.0]],
+            covariance: vec![
+                vec![75.0f64.powi(2), 0.5 * 75.0 * 15.0],
+                vec![0.5 * 75.0 * 15.0, 225.0],
+            ],
         }
     }
 
@@ -320,10 +326,13 @@ mod tests {
             .map(|s| s.parse().unwrap())
             .collect();
         let p = Parameterization::new(model.clone(), params).unwrap();
-        let beta = Marginal::Normal { mean: 68.0, sd: 5.0 };
+        let beta = Marginal::Normal {
+            mean: 68.0,
+            sd: 5.0,
+        };
         let j = joint();
-        let prior = SampledPrior::new(p.clone(), vec![beta; 3], &PriorOverrides::new(), Some(&j))
-            .unwrap();
+        let prior =
+            SampledPrior::new(p.clone(), vec![beta; 3], &PriorOverrides::new(), Some(&j)).unwrap();
         // ln p written out: the bivariate normal (correlation 0.5) plus the beta marginal
         let theta = [700.0, 70.0, 760.0];
         let (z1, z2, r) = ((700.0 - 750.0) / 75.0, (760.0 - 750.0) / 15.0, 0.5f64);
@@ -353,7 +362,11 @@ mod tests {
         // whitened coordinates: a round trip, and the block's prior is N(0, I) there
         let z = prior.to_whitened(&theta);
         let back = prior.from_whitened(&z);
-        assert!(back.iter().zip(theta).all(|(a, b)| (a - b).abs() < 1e-9 * b.abs()));
+        assert!(
+            back.iter()
+                .zip(theta)
+                .all(|(a, b)| (a - b).abs() < 1e-9 * b.abs())
+        );
         let whitened = WhitenedPrior(&prior);
         let standard = -(z[0] * z[0] + z[2] * z[2]) / 2.0 - (2.0 * std::f64::consts::PI).ln();
         assert!((whitened.ln_pdf(&z) - standard - beta.ln_pdf(70.0)).abs() < 1e-12);
@@ -362,7 +375,10 @@ mod tests {
     #[test]
     fn files_and_misuse() {
         let text = serde_json::to_string(&joint()).unwrap();
-        assert_eq!(PriorFile::from_json_str(&text).unwrap(), PriorFile::Joint(joint()));
+        assert_eq!(
+            PriorFile::from_json_str(&text).unwrap(),
+            PriorFile::Joint(joint())
+        );
         let marginal = r#"{"kt_n_per_mm2": {"kind": "normal", "mean": 700, "sd": 70}}"#;
         assert!(matches!(
             PriorFile::from_json_str(marginal).unwrap(),
@@ -370,19 +386,32 @@ mod tests {
         ));
         assert!(PriorFile::from_json_str(r#"{"parameter_names": ["fn1_hz"]}"#).is_err());
         let model = examples::schmitz_2023_milling();
-        let only_ks = Parameterization::new(model.clone(), vec![ModelParameter::KsNPerMm2]).unwrap();
+        let only_ks =
+            Parameterization::new(model.clone(), vec![ModelParameter::KsNPerMm2]).unwrap();
         let m = vec![Marginal::Normal { mean: 1.0, sd: 1.0 }];
         let err = SampledPrior::new(only_ks, m, &PriorOverrides::new(), Some(&joint()))
             .unwrap_err()
             .to_string();
-        assert!(err.contains("fn1_hz") && err.contains("not a sampled parameter"), "{err}");
+        assert!(
+            err.contains("fn1_hz") && err.contains("not a sampled parameter"),
+            "{err}"
+        );
         // kt with ks, a mode number the model does not have
-        let clash = "kt_n_per_mm2,ks_n_per_mm2".split(',').map(|s| s.parse().unwrap()).collect();
+        let clash = "kt_n_per_mm2,ks_n_per_mm2"
+            .split(',')
+            .map(|s| s.parse().unwrap())
+            .collect();
         assert!(Parameterization::new(model.clone(), clash).is_err());
         let second: Vec<ModelParameter> = vec!["fn2_hz".parse().unwrap()];
-        let err = Parameterization::new(model.clone(), second).unwrap_err().to_string();
-        assert!(err.contains("fn2_hz") && err.contains("x: 1, y: 1"), "{err}");
-        let both: Vec<ModelParameter> = vec!["fn1_hz".parse().unwrap(), "theta_omega_2".parse().unwrap()];
+        let err = Parameterization::new(model.clone(), second)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("fn2_hz") && err.contains("x: 1, y: 1"),
+            "{err}"
+        );
+        let both: Vec<ModelParameter> =
+            vec!["fn1_hz".parse().unwrap(), "theta_omega_2".parse().unwrap()];
         assert!(Parameterization::new(model, both).is_err());
     }
 }

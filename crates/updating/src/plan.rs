@@ -7,9 +7,9 @@ use crate::cuts::CutKernel;
 use crate::defaults::{default_parameters, parameter_prior};
 use crate::ensemble::{BoundaryEnsemble, TestPlan, material_removal_rate_cm3_per_min};
 use crate::error::{Result, UpdatingError};
+use crate::joint_prior::{JointNormal, SampledPrior};
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::update::PriorOverrides;
-use crate::joint_prior::{JointNormal, SampledPrior};
 use chatter_bayes::prior::Marginal;
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_progress::Observer;
@@ -231,7 +231,9 @@ pub fn plan_next_cut(
         }
     };
     let max_depth = depths.iter().copied().fold(0.0, f64::max);
-    let solver = settings.method.map_or_else(SolverOptions::default, SolverOptions::new);
+    let solver = settings
+        .method
+        .map_or_else(SolverOptions::default, SolverOptions::new);
     let options = solver.with_max_depth_m((2.0 * max_depth).max(1e-3));
     let kernel = settings
         .kernel

@@ -116,7 +116,8 @@ pub fn reproduction(paths: usize, seed: u64, observer: &dyn Observer) -> Result<
     ];
     let chatter = chatter_stability::zero_order::zoa_lobes(&model, &[10985.0])?;
     rows.push(Reproduced {
-        quantity: "Sec. 6 chatter frequency of test 3 near 11 000 rpm (Hz; ours: mean model)".into(),
+        quantity: "Sec. 6 chatter frequency of test 3 near 11 000 rpm (Hz; ours: mean model)"
+            .into(),
         paper: PAPER_CHATTER_HZ,
         ours: chatter[0].chatter_hz,
         tolerance: 50.0,

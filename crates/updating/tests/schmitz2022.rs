@@ -17,7 +17,14 @@ fn paper_numbers_beside_ours() {
     let rows = reproduction(200, 4, &Silent).unwrap();
     println!("{}", table(&rows));
     for r in &rows {
-        assert!(r.within(), "{}: paper {} ours {} (tolerance {})", r.quantity, r.paper, r.ours, r.tolerance);
+        assert!(
+            r.within(),
+            "{}: paper {} ours {} (tolerance {})",
+            r.quantity,
+            r.paper,
+            r.ours,
+            r.tolerance
+        );
     }
     assert_eq!(rows.len(), 4 + 4 + 3);
 }
@@ -29,13 +36,26 @@ fn proposed_cut_is_on_the_contour_of_the_exported_boundaries_and_the_cap_stops()
     let out = plan_next_cut(&model, &Observations::default(), &settings, &Silent).unwrap();
     assert_eq!(
         out.parameter_names,
-        ["ks_n_per_mm2", "beta_deg", "fn1_hz", "k1_n_per_m", "zeta1", "fn2_hz", "k2_n_per_m", "zeta2"]
+        [
+            "ks_n_per_mm2",
+            "beta_deg",
+            "fn1_hz",
+            "k1_n_per_m",
+            "zeta1",
+            "fn2_hz",
+            "k2_n_per_m",
+            "zeta2"
+        ]
     );
     let cut = out.next_cut.unwrap();
     // P_s written out from the exported boundaries: the share of path probability whose limit
     // at the cut's speed lies above the cut's depth
     let b = &out.boundaries;
-    let k = b.speeds_rpm.iter().position(|s| *s == cut.speed_rpm).unwrap();
+    let k = b
+        .speeds_rpm
+        .iter()
+        .position(|s| *s == cut.speed_rpm)
+        .unwrap();
     let p: f64 = b
         .probabilities
         .iter()

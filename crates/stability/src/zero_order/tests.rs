@@ -398,7 +398,9 @@ fn residual_terms_in_the_table_agree_with_their_sampled_receptance() {
         .zip(&plain)
         .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
         .fold(0.0, f64::max);
-    eprintln!("residual terms: table vs sampled {worst:.2e}, moved from the modes alone {moved:.3}");
+    eprintln!(
+        "residual terms: table vs sampled {worst:.2e}, moved from the modes alone {moved:.3}"
+    );
     assert!(worst < 1e-4, "{worst}");
     assert!(moved > 0.05, "{moved}");
     let options = BoundaryOptions::default();
