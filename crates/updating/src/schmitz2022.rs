@@ -69,7 +69,7 @@ pub fn prior() -> Result<JointNormal> {
 }
 
 /// The plan settings of 004 before the first cut: the correlated prior, `paths` paths, the
-/// zero-order boundaries 004 uses ([10] of the paper), 41 speeds over 8000-16 000 rpm (the
+/// zero-order boundaries 004 uses (reference 10 of the paper), 41 speeds over 8000-16 000 rpm (the
 /// lobes around the paper's tests) and 60 depths up to 6 mm.
 pub fn first_cut_settings(p_test: f64, paths: usize, seed: u64) -> Result<PlanSettings> {
     Ok(PlanSettings {

@@ -356,7 +356,7 @@ fn complex_modes_in_the_table_agree_with_their_sampled_receptance() {
 /// 0.05 Hz (a different solver); the terms move the lobes, and FDM and SDM refuse them by name.
 #[test]
 fn residual_terms_in_the_table_agree_with_their_sampled_receptance() {
-    use crate::{Method, StabilitySolver, boundary::BoundaryOptions};
+    use crate::{Method, boundary::BoundaryOptions};
     use chatter_dynamics::ResidualTerms;
     let base = examples::schmitz_2023_milling();
     // x: a fifth of the modal flexibility above the band and an inertance term below it; y:
