@@ -6,7 +6,7 @@ use crate::output::write_atomic;
 use crate::plot::{Series, line_chart};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::ModelFile;
-use chatter_dynamics::model_file::ModeFile;
+use chatter_dynamics::model_file::{ModeFile, ResidualFile};
 use chatter_frf::{FitOptions, MeasuredModel, ModalFit, fit_modes, read_frf, read_model_file};
 use chatter_stability::boundary::LobePoint;
 use chatter_stability::zero_order::{ZeroOrderOptions, measured_limiting_depths};
@@ -95,6 +95,11 @@ pub struct FitFrfArgs {
     /// modes fit at least 5 % better than the real ones).
     #[arg(long, value_enum, default_value = "auto")]
     mode_form: ModeForm,
+    /// Also write the fit's residual terms for --direction (upper U m/N and lower L 1/kg, the
+    /// modes outside the band) as the model's `residuals`; with complex modes only (they were
+    /// fitted together). Only the zero-order method takes them; FDM and SDM refuse them.
+    #[arg(long)]
+    with_residuals: bool,
     /// Output model file (JSON).
     #[arg(long)]
     out: PathBuf,
@@ -169,6 +174,22 @@ pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
         ModeForm::Real => false,
         ModeForm::Complex => true,
     };
+    if args.with_residuals && !complex {
+        bail!(
+            "--with-residuals: the residual terms were fitted with the complex modes, and real \
+             modes are written (--mode-form {}); use --mode-form complex",
+            if args.mode_form == ModeForm::Real {
+                "real"
+            } else {
+                "auto chose real"
+            }
+        );
+    }
+    let residual = args.with_residuals.then(|| ResidualFile {
+        direction: args.direction.clone(),
+        upper_m_per_n: fit.upper_residual_m_per_n,
+        lower_per_kg: fit.lower_residual_per_kg,
+    });
     let modes = mode_entries(&fit, complex, &args.direction)?;
     if modes.is_empty() {
         bail!(
@@ -189,6 +210,17 @@ pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
                         .is_none_or(|s| s.get(&args.direction).is_none_or(|v| *v == 0.0))
             });
             file.modes.extend(modes);
+            // the residual terms of this direction belonged to the replaced modes
+            let mut residuals: Vec<ResidualFile> = file
+                .residuals
+                .take()
+                .unwrap_or_default()
+                .into_iter()
+                .filter(|r| r.direction != args.direction)
+                .chain(residual)
+                .collect();
+            residuals.sort_by(|a, b| a.direction.cmp(&b.direction));
+            file.residuals = (!residuals.is_empty()).then_some(residuals);
             file.measured_frf = None;
             // validate the result before writing it
             file.validate()
@@ -201,7 +233,11 @@ pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
                  cutting (or pass --model) to use it as a model file",
                 args.out.display()
             );
-            serde_json::to_string_pretty(&serde_json::json!({ "modes": modes }))?
+            let mut json = serde_json::json!({ "modes": modes });
+            if let Some(r) = residual {
+                json["residuals"] = serde_json::json!([r]);
+            }
+            serde_json::to_string_pretty(&json)?
         }
     };
     write_atomic(&args.out, json.as_bytes())?;
@@ -215,6 +251,7 @@ pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
         "nrmse_real_modes": fit.real_mode_relative_misfit,
         "nrmse_complex_modes": fit.complex_mode_relative_misfit,
         "modes_in_model": if complex { "complex" } else { "real" },
+        "residuals_in_model": args.with_residuals,
         "modes_dropped_from_model": dropped,
     });
     println!("{}", serde_json::to_string_pretty(&report)?);

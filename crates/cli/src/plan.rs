@@ -5,6 +5,7 @@ use crate::progress::Bar;
 use anyhow::{Context, Result};
 use chatter_jobs::plan::PlanRequest;
 
+use chatter_updating::joint_prior::PriorFile;
 use chatter_updating::parameters::parse_model_parameters;
 use chatter_updating::plan::{SampledBoundaries, Strategy};
 use chatter_updating::update::PriorOverrides;
@@ -39,7 +40,9 @@ pub struct PlanArgs {
     /// process damping).
     #[arg(long)]
     parameters: Option<String>,
-    /// Priors file (as for `chatter update`).
+    /// Priors file: marginals by name (as for `chatter update`), or one correlated normal
+    /// `{"parameter_names", "mean", "covariance"}` such as 004's RCSA prior (its names are then
+    /// the sampled parameters unless --parameters is given).
     #[arg(long)]
     priors: Option<PathBuf>,
     /// The parameter whose uncertainty value of information reduces; default c_n_per_m when
@@ -58,6 +61,10 @@ pub struct PlanArgs {
     /// Feed per tooth (mm) for the material removal rate.
     #[arg(long, default_value_t = 0.1)]
     feed_per_tooth_mm: f64,
+    /// Stability method of the sampled boundaries: fdm (default), sdm, or zoa (the
+    /// zero-order method 004 used; complex modes need it).
+    #[arg(long, value_enum)]
+    method: Option<crate::commands::Method>,
     /// Seed of the prior samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -187,14 +194,22 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
             "--speeds",
         )?;
     }
-    let priors: PriorOverrides = match &args.priors {
+    let (priors, joint_prior) = match &args.priors {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("reading the priors file {}", path.display()))?;
-            serde_json::from_str(&text)
-                .with_context(|| format!("{}: invalid priors file", path.display()))?
+            match PriorFile::from_json_str(&text).with_context(|| {
+                format!(
+                    "{}: invalid priors file (expected marginals by name, or \
+                     {{\"parameter_names\", \"mean\", \"covariance\"}})",
+                    path.display()
+                )
+            })? {
+                PriorFile::Marginals(m) => (m, None),
+                PriorFile::Joint(j) => (PriorOverrides::new(), Some(j)),
+            }
         }
-        None => PriorOverrides::new(),
+        None => (PriorOverrides::new(), None),
     };
     let request = PlanRequest {
         strategy: match args.strategy {
@@ -208,11 +223,13 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
             .map(parse_model_parameters)
             .transpose()?,
         priors,
+        joint_prior,
         target: args.target.as_deref().map(str::parse).transpose()?,
         paths: args.paths,
         speeds_rpm: speeds,
         depths_mm: depths,
         feed_per_tooth_mm: args.feed_per_tooth_mm,
+        method: args.method,
         seed: args.seed,
         max_tests: args.max_tests,
         sigma_depth_mm: args.sigma_depth_mm,

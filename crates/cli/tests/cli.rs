@@ -708,6 +708,50 @@ fn plan_prints_the_next_cut() {
     );
 }
 
+/// 004 from its example files: `plan --strategy mrr` with the correlated RCSA prior file samples
+/// the prior's eight parameters and proposes a first cut on the P_test contour (P_s within 0.05
+/// of P_test); a prior file naming a parameter that is not sampled is refused by name.
+#[test]
+fn plan_takes_the_004_correlated_prior() {
+    let plan = |extra: &[&str]| {
+        let mut c = chatter();
+        c.args([
+            "plan",
+            "--quiet",
+            "--strategy",
+            "mrr",
+            "--method",
+            "zoa",
+            "--paths",
+            "60",
+        ])
+        .args([
+            "--speeds",
+            "8000:16000:21",
+            "--depths",
+            "0.1:6:60",
+            "--p-test",
+            "0.25",
+        ])
+        .arg("--model")
+        .arg(example("schmitz2022_rcsa_model.json"))
+        .arg("--priors")
+        .arg(example("schmitz2022_rcsa_prior.json"))
+        .args(extra);
+        c
+    };
+    let plan_json: serde_json::Value = serde_json::from_str(&succeed(&mut plan(&[]))).unwrap();
+    assert_eq!(plan_json["parameter_names"][2], "fn1_hz");
+    assert_eq!(plan_json["parameter_names"].as_array().unwrap().len(), 8);
+    let p = plan_json["next_cut"]["p_stable"].as_f64().unwrap();
+    assert!((p - 0.25).abs() <= 0.05, "{p}");
+    let err = fail(&mut plan(&["--parameters", "kt_n_per_mm2,kn_n_per_mm2"]));
+    assert!(
+        err.contains("ks_n_per_mm2") && err.contains("not a sampled parameter"),
+        "{err}"
+    );
+}
+
 /// `chatter oma` on a small signal file: a seeded 800 Hz mode (zeta 2 %) on two channels plus a
 /// once-per-revolution tachometer at 7150 rpm, 4 s at 10 kHz. The pole comes back in the
 /// observations schema (frequency within 0.4 %, damping within 20 %, ten repetitions), the
@@ -993,10 +1037,13 @@ fn fit_frf_complex_modes_reproduce_the_cutpro_lobes() {
                 .arg("--model")
                 .arg(from)
                 .arg("--out")
-                .arg(to),
+                .arg(to)
+                // y also writes its residual terms, which only the zero-order method takes
+                .args((direction == "y").then_some("--with-residuals")),
         );
         let r: serde_json::Value = serde_json::from_str(&report).unwrap();
         assert_eq!(r["modes_in_model"], "complex", "{report}");
+        assert_eq!(r["residuals_in_model"], direction == "y", "{report}");
         assert!(
             r["nrmse_complex_modes"].as_f64().unwrap() < 1e-3,
             "{report}"
@@ -1005,6 +1052,7 @@ fn fit_frf_complex_modes_reproduce_the_cutpro_lobes() {
     let text = std::fs::read_to_string(&fit_xy).unwrap();
     let file: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(file["modes"].as_array().unwrap().len(), 4, "{text}");
+    assert_eq!(file["residuals"][0]["direction"], "y", "{text}");
     let lobes = |m: &PathBuf| {
         lobe_depths(&succeed(
             chatter()
@@ -1046,10 +1094,26 @@ fn fit_frf_complex_modes_reproduce_the_cutpro_lobes() {
             ])
             .arg(&fit_xy),
     );
-    assert!(
-        err.contains("fdm") && err.contains("residue_phase_deg"),
-        "{err}"
+    assert!(err.contains("fdm") && err.contains("residuals[y]"), "{err}");
+    // residual terms come with the complex modes they were fitted with
+    let err = fail(
+        chatter()
+            .arg("fit-frf")
+            .arg("--frf")
+            .arg(&x)
+            .args([
+                "--fmin-hz",
+                "100",
+                "--fmax-hz",
+                "3000",
+                "--mode-form",
+                "real",
+            ])
+            .arg("--with-residuals")
+            .arg("--out")
+            .arg(dir.path().join("never.json")),
     );
+    assert!(err.contains("--with-residuals"), "{err}");
 }
 
 /// `chatter bands --kind geometric` on the CutPro `measured_frf` model: with stated offsets

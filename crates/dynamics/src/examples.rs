@@ -24,6 +24,12 @@ pub const KARANDIKAR_FLEXURE_MODEL: &str = include_str!("../data/karandikar_flex
 /// Observations of seed 003: the cuts its text reports.
 pub const KARANDIKAR_FLEXURE_OBSERVATIONS: &str =
     include_str!("../data/karandikar_flexure_observations.json");
+/// Model file of seed 004 (Schmitz et al. 2022): its 12.7 mm three-flute end mill at 75 %
+/// radial immersion, modes at the mean of the RCSA prior, K_s 600 N/mm^2, beta 68 deg.
+pub const SCHMITZ_2022_RCSA_MODEL: &str = include_str!("../data/schmitz2022_rcsa_model.json");
+/// Seed 004's correlated prior over [K_s, beta, f_n1, k_1, zeta_1, f_n2, k_2, zeta_2]: the prior
+/// file `chatter plan --priors` reads (written by chatter-rcsa's `prior_map` example).
+pub const SCHMITZ_2022_RCSA_PRIOR: &str = include_str!("../data/schmitz2022_rcsa_prior.json");
 /// Observations of seed 002: Table 2 poles and their stable cuts.
 pub const EBRAHIMI_2025_MILLING_OBSERVATIONS: &str =
     include_str!("../data/ebrahimi2025_milling_observations.json");
@@ -53,6 +59,11 @@ pub fn ahmadi_2022_turning_observations() -> Observations {
 /// Milling example of seed 001 (4 teeth, 20 % down milling, 750 Hz, 3 %, 3e6 N/m, x and y).
 pub fn schmitz_2023_milling() -> ModalModel {
     embedded_model(SCHMITZ_2023_MILLING_MODEL, "schmitz2023_milling_model.json")
+}
+/// Seed 004's end mill (three flutes, 75 % down milling, two modes in x and y at the RCSA
+/// prior mean).
+pub fn schmitz_2022_rcsa() -> ModalModel {
+    embedded_model(SCHMITZ_2022_RCSA_MODEL, "schmitz2022_rcsa_model.json")
 }
 /// Experimental milling case of seed 002 (hammer values before milling).
 pub fn ebrahimi_2025_milling() -> ModalModel {

@@ -31,11 +31,18 @@ impl ModalModel {
     /// // static compliance of one 3e6 N/m mode in x
     /// assert!((g0.re - 1.0 / 3.0e6).abs() < 1e-15);
     /// ```
+    /// Residual terms ([`crate::model::ResidualTerms`]) add to the direct receptances.
     pub fn receptance(&self, frequency_hz: f64, i: usize, j: usize) -> Complex64 {
-        self.modes()
+        let modes: Complex64 = self
+            .modes()
             .iter()
             .map(|m| m.receptance(frequency_hz, i, j))
-            .sum()
+            .sum();
+        if i == j {
+            modes + self.residuals()[i].receptance(frequency_hz)
+        } else {
+            modes
+        }
     }
 
     /// The 2 x 2 receptance matrix at `frequency_hz`, rows = response, columns = force.
@@ -134,5 +141,63 @@ mod tests {
             (back.modes()[0].residue_phase_rad() - 0.3).abs() < 1e-12,
             "{text}"
         );
+    }
+
+    /// Residual terms from a model file: the direct receptances gain U - L / w^2 (written out),
+    /// cross terms none; the file round-trips them; bad entries name their field.
+    #[test]
+    fn residual_terms_add_to_the_direct_receptances() {
+        let path = std::path::Path::new("r.json");
+        let file = |residuals: &str| {
+            format!(
+                r#"{{"operation": {{"kind": "milling", "teeth": 2, "radial_immersion": 0.5, "direction": "down"}},
+                   "cutting": {{"kt_n_per_mm2": 700, "kn_n_per_mm2": 200}},
+                   "modes": [{{"frequency_hz": 600, "damping_ratio": 0.03, "shape": {{"x": 2.0, "y": 1.0}}}}],
+                   "residuals": [{residuals}]}}"#
+            )
+        };
+        let model = crate::ModalModel::from_json_str(
+            &file(r#"{"direction": "y", "upper_m_per_n": 2e-8}, {"direction": "x", "upper_m_per_n": 5e-8, "lower_per_kg": 0.4}"#),
+            path,
+        )
+        .unwrap();
+        let bare = model.with_residuals(Default::default()).unwrap();
+        for f in [50.0, 400.0, 600.0, 1700.0] {
+            let w = 2.0 * PI * f;
+            let gx = model.receptance(f, 0, 0) - bare.receptance(f, 0, 0);
+            let gy = model.receptance(f, 1, 1) - bare.receptance(f, 1, 1);
+            assert!((gx - Complex64::new(5e-8 - 0.4 / (w * w), 0.0)).norm() < 1e-22);
+            assert!((gy - Complex64::new(2e-8, 0.0)).norm() < 1e-22);
+            assert_eq!(model.receptance(f, 0, 1), bare.receptance(f, 0, 1));
+        }
+        // without a lower term the static receptance stays finite
+        assert!(
+            bare.with_residuals([Default::default(), model.residuals()[1]])
+                .unwrap()
+                .receptance(0.0, 1, 1)
+                .re
+                .is_finite()
+        );
+        let back = crate::ModalModel::from_json_str(&model.to_json_string(), path).unwrap();
+        assert_eq!(back.residuals(), model.residuals());
+        assert_eq!(
+            back.with_modes(back.modes().to_vec()).unwrap().residuals(),
+            model.residuals()
+        );
+        for (entry, needle) in [
+            (
+                r#"{"direction": "z", "upper_m_per_n": 1e-8}"#,
+                "residuals[0].direction",
+            ),
+            (r#"{"direction": "x"}, {"direction": "x"}"#, "twice"),
+            (r#"{"direction": "x", "lower_kg": 1}"#, "lower_kg"),
+        ] {
+            let e = crate::ModalModel::from_json_str(&file(entry), path)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{e}");
+        }
+        let e = model.require_proportional("SDM").unwrap_err().to_string();
+        assert!(e.contains("SDM") && e.contains("residuals[x]"), "{e}");
     }
 }

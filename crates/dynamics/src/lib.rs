@@ -42,7 +42,7 @@ pub mod sampled;
 pub mod simulate;
 
 pub use error::{DynamicsError, Result};
-pub use model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
+pub use model::{CuttingCoefficients, ModalModel, Mode, ModeShape, ResidualTerms};
 pub use model_file::{MeasuredFrfFile, ModelFile};
 pub use observations::{Cut, CutEvidence, Observations, PoleObservation, SignalRecord};
 pub use operation::{Coordinate, Milling, MillingDirection, Operation, Turning};

@@ -20,6 +20,14 @@
 //! size of the residue, |A| = w_n^2 / (2 w_d k); the phase rotates it. Methods built on real
 //! modal coordinates (FDM, SDM, the frequency-domain poles, time-domain simulation) refuse such
 //! modes ([`ModalModel::require_proportional`]); the zero-order method uses them.
+//!
+//! # Residual terms
+//! A fit over a band stands for the modes outside it by residual terms ([`ResidualTerms`],
+//! `residuals` in model files): each coordinate's direct receptance gains U - L / w^2 (upper
+//! residual U in m/N, the modes above the band; lower residual L in 1/kg, the modes below it),
+//! G_ii(i w) += U_i - L_i / w^2. They have no modal coordinate, so only the zero-order method,
+//! which works on the receptance itself, uses them; the others refuse them by name
+//! ([`ModalModel::require_proportional`]).
 
 use crate::error::{DynamicsError, Result, finite, non_negative, positive};
 use crate::operation::Operation;
@@ -266,13 +274,42 @@ impl CuttingCoefficients {
     }
 }
 
-/// A complete machine model: operation, cutting coefficients, modes and optional process damping.
+/// Residual terms of one coordinate's direct receptance (module docs): G_ii += U - L / w^2.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ResidualTerms {
+    /// Upper residual U (m/N): flexibility of the modes above the fitted band.
+    pub upper_m_per_n: f64,
+    /// Lower residual L (1/kg): inertance of the modes below the fitted band, the term -L / w^2.
+    pub lower_per_kg: f64,
+}
+
+impl ResidualTerms {
+    /// No residual terms.
+    pub fn is_zero(&self) -> bool {
+        self.upper_m_per_n == 0.0 && self.lower_per_kg == 0.0
+    }
+
+    /// U - L / w^2 at `frequency_hz` (m/N; the lower term is left out where L = 0, so a model
+    /// without it has a finite static receptance).
+    pub fn receptance(&self, frequency_hz: f64) -> f64 {
+        let mut g = self.upper_m_per_n;
+        if self.lower_per_kg != 0.0 {
+            let w = 2.0 * PI * frequency_hz;
+            g -= self.lower_per_kg / (w * w);
+        }
+        g
+    }
+}
+
+/// A complete machine model: operation, cutting coefficients, modes, optional residual terms
+/// and optional process damping.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModalModel {
     name: Option<String>,
     operation: Operation,
     cutting: CuttingCoefficients,
     modes: Vec<Mode>,
+    residuals: [ResidualTerms; 2],
     process_damping_n_per_m: Option<f64>,
 }
 
@@ -313,8 +350,26 @@ impl ModalModel {
             operation,
             cutting,
             modes,
+            residuals: [ResidualTerms::default(); 2],
             process_damping_n_per_m,
         })
+    }
+
+    /// The same model with residual terms per coordinate (module docs); finite values.
+    pub fn with_residuals(&self, residuals: [ResidualTerms; 2]) -> Result<Self> {
+        for (i, r) in residuals.iter().enumerate() {
+            finite(&format!("residuals[{i}].upper_m_per_n"), r.upper_m_per_n)?;
+            finite(&format!("residuals[{i}].lower_per_kg"), r.lower_per_kg)?;
+        }
+        Ok(Self {
+            residuals,
+            ..self.clone()
+        })
+    }
+
+    /// Residual terms per coordinate (zero where none).
+    pub fn residuals(&self) -> [ResidualTerms; 2] {
+        self.residuals
     }
 
     /// Free-text name (which paper table the model comes from, for the examples).
@@ -346,7 +401,8 @@ impl ModalModel {
             self.cutting,
             self.modes.clone(),
             self.process_damping_n_per_m,
-        )
+        )?
+        .with_residuals(self.residuals)
     }
     /// The same model with other cutting coefficients.
     pub fn with_cutting(&self, cutting: CuttingCoefficients) -> Self {
@@ -363,7 +419,8 @@ impl ModalModel {
             self.cutting,
             modes,
             self.process_damping_n_per_m,
-        )
+        )?
+        .with_residuals(self.residuals)
     }
     /// The same model with another process-damping coefficient.
     pub fn with_process_damping(&self, c_n_per_m: Option<f64>) -> Result<Self> {
@@ -373,7 +430,8 @@ impl ModalModel {
             self.cutting,
             self.modes.clone(),
             c_n_per_m,
-        )
+        )?
+        .with_residuals(self.residuals)
     }
     /// The same model renamed.
     pub fn with_name(&self, name: Option<String>) -> Self {
@@ -388,10 +446,23 @@ impl ModalModel {
         self.modes.iter().all(Mode::is_proportional)
     }
 
-    /// An error naming `method` when a mode is non-proportional: for the methods built on real
-    /// modal coordinates q'' + 2 Z Omega q' + Omega^2 q = Phi^T f, which cannot represent a
-    /// complex residue.
+    /// An error naming `method` when a mode is non-proportional or the model has residual
+    /// terms: for the methods built on real modal coordinates q'' + 2 Z Omega q' + Omega^2 q =
+    /// Phi^T f, which represent neither a complex residue nor a receptance term without a mode.
     pub fn require_proportional(&self, method: &str) -> Result<()> {
+        if let Some(i) = self.residuals.iter().position(|r| !r.is_zero()) {
+            let r = self.residuals[i];
+            return Err(DynamicsError::invalid(
+                format!("residuals[{}]", self.operation.coordinates()[i].name()),
+                format!(
+                    "{method} needs modal coordinates, and the residual terms (upper {} m/N, \
+                     lower {} 1/kg) have none; use the zero-order method (`--method zoa`), \
+                     which takes them, or drop `residuals`",
+                    crate::limits::written(r.upper_m_per_n),
+                    crate::limits::written(r.lower_per_kg)
+                ),
+            ));
+        }
         match self.modes.iter().position(|m| !m.is_proportional()) {
             None => Ok(()),
             Some(n) => Err(DynamicsError::invalid(

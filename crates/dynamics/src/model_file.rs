@@ -4,7 +4,7 @@
 
 use crate::error::{DynamicsError, Result};
 use crate::limits;
-use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape};
+use crate::model::{CuttingCoefficients, ModalModel, Mode, ModeShape, ResidualTerms};
 use crate::operation::{Milling, MillingDirection, Operation, Turning};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -24,6 +24,11 @@ pub struct ModelFile {
     /// Structural modes (may be empty when `measured_frf` gives the dynamics).
     #[serde(default)]
     pub modes: Vec<ModeFile>,
+    /// Residual terms of the direct receptances, at most one entry per coordinate
+    /// ([`crate::model`] "Residual terms"): what a band-limited fit (`chatter fit-frf`) adds
+    /// for the modes outside its band. Only the zero-order method takes them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residuals: Option<Vec<ResidualFile>>,
     /// Optional process damping.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub process_damping: Option<ProcessDampingFile>,
@@ -160,12 +165,34 @@ pub struct ModeFile {
     pub residue_phase_deg: Option<f64>,
 }
 
+/// One entry of `residuals`: G_ii += upper_m_per_n - lower_per_kg / w^2 for coordinate i.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ResidualFile {
+    /// Coordinate name (`x`, `y`, `feed`, `cutting`).
+    pub direction: String,
+    /// Upper residual U (m/N): the modes above the fitted band.
+    #[serde(default)]
+    pub upper_m_per_n: f64,
+    /// Lower residual L (1/kg): the modes below the fitted band, the term -L / w^2.
+    #[serde(default)]
+    pub lower_per_kg: f64,
+}
+
 /// `process_damping` object.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ProcessDampingFile {
     /// Coefficient C in F_d = -C b ydot / V.
     pub c_n_per_m: f64,
+}
+
+fn finite_in(field: &str, v: f64) -> Result<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(DynamicsError::value(field, v, "a finite number"))
+    }
 }
 
 fn opt_f(field: &str, v: Option<f64>) -> Result<Option<f64>> {
@@ -458,7 +485,33 @@ impl ModelFile {
             .map(|(i, m)| m.validate(i, &operation))
             .collect::<Result<Vec<_>>>()?;
         let c = self.process_damping.as_ref().map(|p| p.c_n_per_m);
-        ModalModel::new(self.name.clone(), operation, cutting, modes, c)
+        let mut residuals = [ResidualTerms::default(); 2];
+        let mut given = [false; 2];
+        for (k, r) in self.residuals.iter().flatten().enumerate() {
+            let field = |f: &str| format!("residuals[{k}].{f}");
+            let i = operation.coordinate_index(&r.direction).ok_or_else(|| {
+                let names: Vec<_> = operation.coordinates().iter().map(|c| c.name()).collect();
+                DynamicsError::invalid(
+                    field("direction"),
+                    format!(
+                        "`{}` is not a coordinate of this operation; expected one of {names:?}",
+                        r.direction
+                    ),
+                )
+            })?;
+            if given[i] {
+                return Err(DynamicsError::invalid(
+                    field("direction"),
+                    format!("`{}` has residual terms twice; give one entry", r.direction),
+                ));
+            }
+            given[i] = true;
+            residuals[i] = ResidualTerms {
+                upper_m_per_n: finite_in(&field("upper_m_per_n"), r.upper_m_per_n)?,
+                lower_per_kg: finite_in(&field("lower_per_kg"), r.lower_per_kg)?,
+            };
+        }
+        ModalModel::new(self.name.clone(), operation, cutting, modes, c)?.with_residuals(residuals)
     }
 
     /// The file form of a model (inverse of [`ModelFile::validate`]).
@@ -537,6 +590,19 @@ impl ModelFile {
                 beta_deg: None,
             },
             modes,
+            residuals: {
+                let entries: Vec<ResidualFile> = coords
+                    .iter()
+                    .zip(model.residuals())
+                    .filter(|(_, r)| !r.is_zero())
+                    .map(|(c, r)| ResidualFile {
+                        direction: c.name().to_string(),
+                        upper_m_per_n: r.upper_m_per_n,
+                        lower_per_kg: r.lower_per_kg,
+                    })
+                    .collect();
+                (!entries.is_empty()).then_some(entries)
+            },
             process_damping: model
                 .process_damping_n_per_m()
                 .map(|c| ProcessDampingFile { c_n_per_m: c }),

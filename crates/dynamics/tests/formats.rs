@@ -172,7 +172,7 @@ fn examples_parse_and_round_trip() {
             Observations::from_path(&path).unwrap();
         }
     }
-    assert_eq!(models, 4);
+    assert_eq!(models, 5);
 }
 
 fn arbitrary_model() -> impl Strategy<Value = ModalModel> {

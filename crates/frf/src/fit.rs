@@ -181,6 +181,15 @@ fn pole(mode: &FittedMode) -> Complex64 {
 }
 
 impl ModalFit {
+    /// The fit's residual terms as a model holds them (`chatter_dynamics::ResidualTerms`,
+    /// `residuals` in model files): U - L / w^2 on the fitted coordinate's direct receptance.
+    pub fn residual_terms(&self) -> chatter_dynamics::ResidualTerms {
+        chatter_dynamics::ResidualTerms {
+            upper_m_per_n: self.upper_residual_m_per_n,
+            lower_per_kg: self.lower_residual_per_kg,
+        }
+    }
+
     /// The complex-mode fit with its residual terms at `frequency_hz`.
     pub fn receptance(&self, frequency_hz: f64) -> Complex64 {
         let w = 2.0 * PI * frequency_hz;

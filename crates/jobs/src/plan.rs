@@ -5,6 +5,7 @@ use crate::error::{JobError, Result, count};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_progress::Observer;
 use chatter_updating::cuts::CutKernel;
+use chatter_updating::joint_prior::JointNormal;
 
 use chatter_updating::parameters::ModelParameter;
 use chatter_updating::plan::{PlanOutcome, PlanSettings, Strategy, plan_next_cut};
@@ -21,6 +22,8 @@ pub struct PlanRequest {
     pub parameters: Option<Vec<ModelParameter>>,
     /// Priors by name.
     pub priors: PriorOverrides,
+    /// A correlated normal prior over some sampled parameters (004's RCSA prior file).
+    pub joint_prior: Option<JointNormal>,
     /// The parameter whose uncertainty value of information reduces.
     pub target: Option<ModelParameter>,
     /// Sampled stability boundaries (10 to 100 000).
@@ -31,6 +34,8 @@ pub struct PlanRequest {
     pub depths_mm: Option<Vec<f64>>,
     /// Feed per tooth (mm) of the material removal rate.
     pub feed_per_tooth_mm: f64,
+    /// Stability method of the sampled boundaries (default the full discretization).
+    pub method: Option<chatter_stability::prepared::Method>,
     /// Seed of the prior samples.
     pub seed: u64,
     /// Cap on test cuts.
@@ -51,11 +56,13 @@ impl PlanRequest {
             p_test: d.p_test,
             parameters: None,
             priors: PriorOverrides::new(),
+            joint_prior: None,
             target: None,
             paths: d.paths,
             speeds_rpm: None,
             depths_mm: None,
             feed_per_tooth_mm: d.feed_per_tooth_m * 1e3,
+            method: d.method,
             seed: d.seed,
             max_tests: d.max_tests,
             sigma_depth_mm: None,
@@ -88,6 +95,7 @@ impl PlanRequest {
             p_test: self.p_test,
             parameters: self.parameters.clone(),
             priors: self.priors.clone(),
+            joint_prior: self.joint_prior.clone(),
             target: self.target,
             paths: self.paths,
             speeds_rpm: self.speeds_rpm.clone(),
@@ -96,6 +104,7 @@ impl PlanRequest {
                 .as_ref()
                 .map(|d| d.iter().filter(|v| **v > 0.0).map(|v| v * 1e-3).collect()),
             feed_per_tooth_m: self.feed_per_tooth_mm * 1e-3,
+            method: self.method,
             seed: self.seed,
             max_tests: self.max_tests,
             kernel: Some(kernel),

@@ -64,9 +64,13 @@ pub fn parameter_prior(parameter: ModelParameter, model: &ModalModel) -> Margina
             (false, ParameterKind::Zeta) => uniform(0.5),
             (false, _) => uniform(0.1),
         },
-        ModelParameter::KtNPerMm2 | ModelParameter::KnNPerMm2 => {
-            coefficient(parameter.nominal_value(model))
-        }
+        ModelParameter::KtNPerMm2
+        | ModelParameter::KnNPerMm2
+        | ModelParameter::KsNPerMm2
+        | ModelParameter::BetaDeg
+        | ModelParameter::ModeFrequencyHz(_)
+        | ModelParameter::ModeStiffnessNPerM(_)
+        | ModelParameter::ModeDampingRatio(_) => coefficient(parameter.nominal_value(model)),
         ModelParameter::ProcessDampingNPerM => Marginal::Uniform {
             low: 0.5e5,
             high: 10e5,

@@ -26,6 +26,7 @@
 use crate::classes::{Sampler, SamplerOptions, sample_posterior};
 use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
+use crate::joint_prior::{SampledPrior, WhitenedLikelihood, WhitenedPrior};
 use crate::parameters::Parameterization;
 use chatter_bayes::Prior;
 use chatter_bayes::samples::SampleSet;
@@ -167,10 +168,12 @@ impl BoundaryEnsemble {
     /// reweights fixed prior paths (003), the paths follow the posterior however many cuts have
     /// been made. Without cuts, `paths` prior draws. Where rejection sampling keeps too few prior
     /// draws to start the chains (a sharply peaked likelihood), iTMCMC draws the paths instead.
+    /// The samplers run in the prior's whitened coordinates ([`crate::joint_prior`]), so a
+    /// nearly singular correlated prior (004's RCSA ensemble) does not stall the chains.
     #[allow(clippy::too_many_arguments)]
-    pub fn from_posterior<P: Prior>(
+    pub fn from_posterior(
         parameterization: Parameterization,
-        prior: &P,
+        prior: &SampledPrior,
         cuts: &[Cut],
         kernel: &CutKernel,
         paths: usize,
@@ -198,7 +201,16 @@ impl BoundaryEnsemble {
                 samples: paths,
                 seed,
             };
-            sample_posterior(prior, &likelihood, &settings, &chatter_progress::Silent)
+            let whitened = WhitenedLikelihood {
+                prior,
+                likelihood: &likelihood,
+            };
+            sample_posterior(
+                &WhitenedPrior(prior),
+                &whitened,
+                &settings,
+                &chatter_progress::Silent,
+            )
         };
         let posterior = match draw(Sampler::Amcmc) {
             Err(UpdatingError::InvalidInput {
@@ -206,13 +218,14 @@ impl BoundaryEnsemble {
             }) => draw(Sampler::Itmcmc)?,
             other => other?,
         };
-        Self::from_sample_set(
-            parameterization,
-            &posterior.samples,
-            speeds_rpm,
-            options,
-            observer,
-        )
+        let set = &posterior.samples;
+        let samples = set
+            .samples()
+            .iter()
+            .map(|z| prior.from_whitened(z))
+            .collect();
+        let set = SampleSet::new(samples, set.weights().to_vec())?;
+        Self::from_sample_set(parameterization, &set, speeds_rpm, options, observer)
     }
 
     /// `paths` samples drawn from `prior` (path i from its own stream of `seed`).

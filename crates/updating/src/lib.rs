@@ -3,12 +3,14 @@
 //!
 //! | module | holds | source |
 //! |---|---|---|
-//! | [`parameters`] | named parameters (`theta_omega_N`, ..., `kt_n_per_mm2`, `kn_n_per_mm2`, `c_n_per_m`) and theta -> model | 000 Eq. 2, 002 Eq. 16, 003 Eq. 1 |
+//! | [`parameters`] | named parameters (`theta_omega_N`, ..., `kt_n_per_mm2`, `kn_n_per_mm2`, `c_n_per_m`; 004's `ks_n_per_mm2`, `beta_deg`, `fnN_hz`, `kN_n_per_m`, `zetaN`) and theta -> model | 000 Eq. 2, 002 Eq. 16, 003 Eq. 1, 004 Sec. 2 |
+//! | [`joint_prior`] | correlated (multivariate normal) prior block from a prior file, times marginals | 004 Sec. 2 |
 //! | [`turning`] | identified turning poles against the characteristic equation, sigma_I^2 = alpha sigma_R^2 | 000 Eq. 28-31 |
 //! | [`milling`] | identified Floquet multipliers (frequency, damping) against the exact discretized monodromy operator, sigma_zeta = alpha sigma_w | 002 Eq. 13-15 |
 //! | [`cuts`] | stable / chatter results with chatter frequency; the one-sided kernel | 004 Eq. 5, 003 Eq. 3-4 |
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
+//! | [`schmitz2022`] | 004's example with its correlated RCSA prior: the paper's numbers beside ours | 004 Sec. 2, 3, 6 |
 //! | [`karandikar`] | 003's prior, Table 2's candidate tests with the paper's numbers, RSS identification of C | 003 |
 //! | [`surrogate`] | Matérn GP surrogate of the dominant milling multiplier, with its error against the exact one | 002 Section 2.2 |
 //! | [`prior_bounds`] | posteriors that pile against a prior bound | 000 Section 6.3 |
@@ -43,11 +45,13 @@ pub mod cuts;
 pub mod defaults;
 pub mod ensemble;
 pub mod error;
+pub mod joint_prior;
 pub mod karandikar;
 pub mod milling;
 pub mod parameters;
 pub mod plan;
 pub mod prior_bounds;
+pub mod schmitz2022;
 pub mod surrogate;
 pub mod turning;
 pub mod update;

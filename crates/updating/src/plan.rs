@@ -7,12 +7,13 @@ use crate::cuts::CutKernel;
 use crate::defaults::{default_parameters, parameter_prior};
 use crate::ensemble::{BoundaryEnsemble, TestPlan, material_removal_rate_cm3_per_min};
 use crate::error::{Result, UpdatingError};
+use crate::joint_prior::{JointNormal, SampledPrior};
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::update::PriorOverrides;
-use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_bayes::prior::Marginal;
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_progress::Observer;
-use chatter_stability::prepared::SolverOptions;
+use chatter_stability::prepared::{Method, SolverOptions};
 
 /// How the next test is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -39,6 +40,9 @@ pub struct PlanSettings {
     pub parameters: Option<Vec<ModelParameter>>,
     /// Priors by name.
     pub priors: PriorOverrides,
+    /// A correlated normal prior over some sampled parameters (004's RCSA prior); without
+    /// `parameters` its names are the sampled parameters.
+    pub joint_prior: Option<JointNormal>,
     /// The parameter whose uncertainty the value of information reduces (default C when
     /// sampled, else the first parameter).
     pub target: Option<ModelParameter>,
@@ -50,6 +54,9 @@ pub struct PlanSettings {
     pub depths_m: Option<Vec<f64>>,
     /// Feed per tooth (m) for the material removal rate.
     pub feed_per_tooth_m: f64,
+    /// Stability method of the sampled boundaries (default [`SolverOptions`]'s: the full
+    /// discretization; 004 used the zero-order method).
+    pub method: Option<Method>,
     /// Seed of the prior samples.
     pub seed: u64,
     /// Cap on the number of test cuts: the stopping rule fires once this many cuts were made
@@ -70,11 +77,13 @@ impl Default for PlanSettings {
             p_test: 0.5,
             parameters: None,
             priors: PriorOverrides::new(),
+            joint_prior: None,
             target: None,
             paths: 300,
             speeds_rpm: None,
             depths_m: None,
             feed_per_tooth_m: 0.1e-3,
+            method: None,
             seed: 0,
             max_tests: DEFAULT_MAX_TESTS,
             kernel: None,
@@ -196,29 +205,24 @@ pub fn plan_next_cut(
             message: format!("{}; expected > 0", settings.feed_per_tooth_m),
         });
     }
-    let parameters = match &settings.parameters {
-        Some(p) => p.clone(),
-        None => default_parameters(model, &[])?,
+    let parameters = match (&settings.parameters, &settings.joint_prior) {
+        (Some(p), _) => p.clone(),
+        (None, Some(joint)) => joint.parameters()?,
+        (None, None) => default_parameters(model, &[])?,
     };
     let p = Parameterization::new(model.clone(), parameters)?;
     let names = p.names();
-    let mut marginals: Vec<Marginal> = p
+    let marginals: Vec<Marginal> = p
         .parameters()
         .iter()
         .map(|q| parameter_prior(*q, model))
         .collect();
-    for (name, spec) in &settings.priors {
-        let k =
-            names
-                .iter()
-                .position(|n| n == name)
-                .ok_or_else(|| UpdatingError::InvalidInput {
-                    field: "priors",
-                    message: format!("`{name}` is not a sampled parameter ({})", names.join(", ")),
-                })?;
-        marginals[k] = *spec;
-    }
-    let prior = IndependentPrior::new(marginals)?;
+    let prior = SampledPrior::new(
+        p.clone(),
+        marginals,
+        &settings.priors,
+        settings.joint_prior.as_ref(),
+    )?;
     let (speeds, depths) = match (&settings.speeds_rpm, &settings.depths_m) {
         (Some(s), Some(d)) => (s.clone(), d.clone()),
         (s, d) => {
@@ -227,7 +231,10 @@ pub fn plan_next_cut(
         }
     };
     let max_depth = depths.iter().copied().fold(0.0, f64::max);
-    let options = SolverOptions::default().with_max_depth_m((2.0 * max_depth).max(1e-3));
+    let solver = settings
+        .method
+        .map_or_else(SolverOptions::default, SolverOptions::new);
+    let options = solver.with_max_depth_m((2.0 * max_depth).max(1e-3));
     let kernel = settings
         .kernel
         .unwrap_or(match settings.strategy {

@@ -11,7 +11,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_bayes::prior::Marginal;
 use chatter_dynamics::{
     Cut, CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
 };
@@ -22,6 +22,7 @@ use chatter_stability::prepared::SolverOptions;
 use chatter_stability::prepared::{PreparedDiscretization, PreparedSolver};
 use chatter_updating::cuts::CutKernel;
 use chatter_updating::ensemble::{BoundaryEnsemble, material_removal_rate_cm3_per_min};
+use chatter_updating::joint_prior::SampledPrior;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
 
 /// A 3-flute 12.7 mm endmill at 75 % radial immersion (004), two tool modes.
@@ -83,24 +84,29 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
         })
         .fold(0.0, f64::max);
 
-    let prior = IndependentPrior::new(vec![
-        Marginal::Normal {
-            mean: 700.0,
-            sd: 70.0,
-        },
-        Marginal::Normal {
-            mean: 210.0,
-            sd: 21.0,
-        },
-        Marginal::Uniform {
-            low: -0.05,
-            high: 0.05,
-        },
-        Marginal::Uniform {
-            low: -0.05,
-            high: 0.05,
-        },
-    ])
+    let prior = SampledPrior::new(
+        p.clone(),
+        vec![
+            Marginal::Normal {
+                mean: 700.0,
+                sd: 70.0,
+            },
+            Marginal::Normal {
+                mean: 210.0,
+                sd: 21.0,
+            },
+            Marginal::Uniform {
+                low: -0.05,
+                high: 0.05,
+            },
+            Marginal::Uniform {
+                low: -0.05,
+                high: 0.05,
+            },
+        ],
+        &Default::default(),
+        None,
+    )
     .unwrap();
     let options = SolverOptions::default().with_max_depth_m(10e-3);
     let mut samples =

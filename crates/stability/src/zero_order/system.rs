@@ -4,7 +4,8 @@
 //!
 //! G(i w) = sum_n phi_n phi_n^T / (w_n^2 - w^2 + 2 i zeta_n w_n w),
 //!
-//! over mass-normalized mode shapes phi_n; a non-proportional (complex) mode multiplies its term
+//! over mass-normalized mode shapes phi_n, plus the residual terms U_i - L_i / w^2 of the direct
+//! receptances (`chatter_dynamics::ResidualTerms`); a non-proportional (complex) mode multiplies its term
 //! by n_0 + n_1 i w ([`chatter_dynamics::model::complex_mode_numerator`]). Process damping (003 Section 2) enters as the
 //! equivalent damping ratios zeta_n + b s_n of [`crate::process_damping::with_equivalent_damping`],
 //! with s_n = d zeta_n / d b from [`crate::process_damping::damping_ratio_slope_per_m`].
@@ -14,7 +15,7 @@
 
 use super::Lobe;
 use crate::error::{Result, invalid};
-use chatter_dynamics::ModalModel;
+use chatter_dynamics::{ModalModel, ResidualTerms};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -41,6 +42,8 @@ pub struct ModalTerm {
 pub struct OrientedSystem {
     modes: Vec<ModalTerm>,
     directional_n_per_m2: [[f64; 2]; 2],
+    /// Residual terms of the direct receptances (`chatter_dynamics::ResidualTerms`).
+    residuals: [ResidualTerms; 2],
 }
 
 /// Process damping folded into the modal damping ratios at one depth: zeta_n + b s_n.
@@ -162,6 +165,7 @@ impl OrientedSystem {
         Ok(Self {
             modes,
             directional_n_per_m2,
+            residuals: [ResidualTerms::default(); 2],
         })
     }
 
@@ -178,7 +182,9 @@ impl OrientedSystem {
                 numerator: m.receptance_numerator(),
             })
             .collect();
-        Self::new(modes, [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]])
+        let mut system = Self::new(modes, [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]])?;
+        system.residuals = model.residuals();
+        Ok(system)
     }
 
     /// The modes.
@@ -213,6 +219,9 @@ impl OrientedSystem {
             g[1] += inv * (p * q);
             g[2] += inv * (q * q);
         }
+        let hz = w / (2.0 * PI);
+        g[0] += self.residuals[0].receptance(hz);
+        g[2] += self.residuals[1].receptance(hz);
         let a = &self.directional_n_per_m2;
         let m00 = g[0] * a[0][0] + g[1] * a[0][1];
         let m01 = g[1] * a[0][0] + g[2] * a[0][1];

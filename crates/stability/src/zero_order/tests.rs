@@ -350,3 +350,68 @@ fn complex_modes_in_the_table_agree_with_their_sampled_receptance() {
         .to_string();
     assert!(e.contains("frequency-domain"), "{e}");
 }
+
+/// Residual terms (`residuals` in model files): the zero-order table with U - L / w^2 on the
+/// direct receptances against the measured-FRF route on the model's receptance sampled at
+/// 0.05 Hz (a different solver); the terms move the lobes, and FDM and SDM refuse them by name.
+#[test]
+fn residual_terms_in_the_table_agree_with_their_sampled_receptance() {
+    use crate::{Method, boundary::BoundaryOptions};
+    use chatter_dynamics::ResidualTerms;
+    let base = examples::schmitz_2023_milling();
+    // x: a fifth of the modal flexibility above the band and an inertance term below it; y:
+    // an upper term only
+    let model = base
+        .with_residuals([
+            ResidualTerms {
+                upper_m_per_n: 0.2 / 3e6,
+                lower_per_kg: 0.5,
+            },
+            ResidualTerms {
+                upper_m_per_n: 0.1 / 3e6,
+                lower_per_kg: 0.0,
+            },
+        ])
+        .unwrap();
+    let speeds: Vec<f64> = (0..40).map(|i| 5000.0 + 250.0 * i as f64).collect();
+    let table = zoa_lobes(&model, &speeds).unwrap();
+    let (lo, hi) = (0.25 * 750.0, 2.0 * 750.0);
+    let grid: Vec<f64> = (0..((hi - lo) / 0.05) as usize)
+        .map(|k| lo + 0.05 * k as f64)
+        .collect();
+    let sampled = measured_limiting_depths(
+        model.operation(),
+        model.cutting(),
+        &model.sampled_receptance(grid).unwrap(),
+        &speeds,
+        &ZeroOrderOptions::unbounded(),
+    )
+    .unwrap();
+    let worst = table
+        .iter()
+        .zip(&sampled)
+        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
+        .fold(0.0, f64::max);
+    let plain = zoa_lobes(&base, &speeds).unwrap();
+    let moved = table
+        .iter()
+        .zip(&plain)
+        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "residual terms: table vs sampled {worst:.2e}, moved from the modes alone {moved:.3}"
+    );
+    assert!(worst < 1e-4, "{worst}");
+    assert!(moved > 0.05, "{moved}");
+    let options = BoundaryOptions::default();
+    for method in [Method::Fdm, Method::Sdm] {
+        let e = Method::prepare(method, &model, &options)
+            .and_then(|s| s.dominant_multiplier(8000.0, 1e-4))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(method.name()) && e.contains("residuals[x]"),
+            "{e}"
+        );
+    }
+}
