@@ -13,7 +13,9 @@
 //!    ([`classes`]): `parameter_error` (recalibration, always a candidate), `process_damping`
 //!    (C b ydot / V, seed 003), `speed_dependent_dynamics` (f_n(Omega) = f_n0 (1 - c Omega^2)),
 //!    `extra_mode` and `drift` (cutting coefficients changing with `sequence`). The log-evidence
-//!    ln p(D | M) of each comes from iTMCMC (`chatter-bayes`), the posterior class probabilities
+//!    ln p(D | M) of each comes from iTMCMC (`chatter-bayes`; for `extra_mode`, whose posterior
+//!    has several modes in the extra mode's frequency, one run per slice of that frequency's
+//!    prior, pooled by total probability: `chatter_bayes::strata`), the posterior class probabilities
 //!    from equal prior odds (000 Eq. 32), and the verdict is the most probable class (an effect
 //!    needs a Bayes factor of 10 over plain recalibration, which it contains) unless a
 //!    posterior predictive check ([`PredictiveCheck`]) finds its residuals inconsistent with

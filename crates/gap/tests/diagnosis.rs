@@ -45,14 +45,25 @@ fn campaign(
     seed: u64,
     classes: &[EffectClass],
 ) -> Diagnosis {
+    seeded_campaign(machine, effect, error, (seed, seed), classes)
+}
+
+/// [`campaign`] with the campaign's and the sampler's seeds apart.
+fn seeded_campaign(
+    machine: usize,
+    effect: HiddenEffect,
+    error: Recalibration,
+    (campaign_seed, sampler_seed): (u64, u64),
+    classes: &[EffectClass],
+) -> Diagnosis {
     let m = &proving_machines().unwrap()[machine];
     let (lo, hi) = m.speed_range_rpm;
-    let mut scenario = Scenario::new(effect, seed).with_speed_range(lo, hi, 4);
+    let mut scenario = Scenario::new(effect, campaign_seed).with_speed_range(lo, hi, 4);
     scenario.error = error;
     let data = synthesize(&m.model, &scenario).unwrap();
     let options = DiagnoseOptions {
         classes: classes.to_vec(),
-        ..options(seed)
+        ..options(sampler_seed)
     };
     let d = diagnose(&m.model, &data, &options, &Silent).unwrap();
     eprintln!("{} / {effect:?}: {}", m.name, summary(&d));
@@ -119,6 +130,34 @@ fn speed_dependent_modes_are_named() {
         "speed_dependent_dynamics",
         "{}",
         summary(&d)
+    );
+}
+
+/// An unmodelled mode at 1.35 times the dominant mode's frequency (the confusion example's
+/// xy machine, extra mode at 2x, its seed 1): with one population the sampler settled on a
+/// wrong mode at 1515 Hz and the verdict was `unexplained`; the frequency strata find the
+/// hidden one. The posterior frequency within 2 % of the truth (the pole frequencies carry 1 %
+/// noise, the chatter frequencies 0.3 %).
+#[test]
+fn an_extra_mode_is_named_at_its_frequency() {
+    let m = &proving_machines().unwrap()[0];
+    let (effect, error) =
+        effect_at(EffectClass::ExtraMode, 2.0, &m.model, m.speed_range_rpm).unwrap();
+    let HiddenEffect::ExtraMode { frequency_hz, .. } = effect else {
+        panic!("{effect:?}")
+    };
+    let d = seeded_campaign(
+        0,
+        effect,
+        error,
+        (1001, 1),
+        &[EffectClass::ParameterError, EffectClass::ExtraMode],
+    );
+    assert_eq!(d.verdict.name(), "extra_mode", "{}", summary(&d));
+    let fitted = d.classes[1].parameters["frequency_hz"].mean;
+    assert!(
+        (fitted / frequency_hz - 1.0).abs() < 0.02,
+        "{fitted} against {frequency_hz}"
     );
 }
 
