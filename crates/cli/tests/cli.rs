@@ -187,6 +187,7 @@ fn demo_writes_its_folder() {
         "milling_bands.csv",
         "milling_bands-theta.svg",
         "milling_bands-distance.svg",
+        "milling_bands-roots.svg",
         "eq34_covariance.json",
         "turning_credibility.csv",
         "turning_credibility.svg",
@@ -201,7 +202,7 @@ fn demo_writes_its_folder() {
     // the report page, in a real browser: every plot drawn, the verdicts in words with units
     let page = dir.path().join("report.html");
     let html = std::fs::read_to_string(&page).unwrap();
-    assert_eq!(html.matches("<figure>").count(), 7);
+    assert_eq!(html.matches("<figure>").count(), 8);
     browser::check(
         &page,
         &[
@@ -222,9 +223,20 @@ fn demo_writes_its_folder() {
             .unwrap();
     assert_eq!(summary["turning_limits"].as_array().unwrap().len(), 4);
     assert_eq!(summary["diagnosis"]["verdict"], "process_damping");
-    // 000 Table 3 (15), 001 lobe extremes (3), 003 Table 2 (8); only D's reduction is outside
-    assert_eq!(summary["papers"]["rows"], 26);
-    assert_eq!(summary["papers"]["within_tolerance"], 25);
+    // 000 Sec. 6.4: credibility bounds on every row, lower <= mean <= upper, and at 7300 rpm
+    // they bracket the test cuts (stable at 3.048 mm below, chatter at 3.81 mm above)
+    let credibility = std::fs::read_to_string(dir.path().join("turning_credibility.csv")).unwrap();
+    for line in credibility.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        assert!(v[2] <= v[1] && v[1] <= v[3], "{line}");
+        if v[0] == 7300.0 {
+            assert!(v[2] > 3.048 && v[3] < 3.81, "{line}");
+        }
+    }
+    assert!(credibility.lines().any(|l| l.starts_with("7300,")));
+    // 000 Table 3 (15), 001 Sec. 4 (15), 003 Table 2 (8); only D's reduction is outside
+    assert_eq!(summary["papers"]["rows"], 38);
+    assert_eq!(summary["papers"]["within_tolerance"], 37);
 }
 
 #[test]
@@ -1522,7 +1534,7 @@ fn geometric_bands_export_raw_roots_and_theta_distance_plots() {
         "speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance,upper_speed_rpm,\
          upper_depth_mm,lower_speed_rpm,lower_depth_mm\n"
     ));
-    for f in ["b.svg", "b-theta.svg", "b-distance.svg"] {
+    for f in ["b.svg", "b-theta.svg", "b-distance.svg", "b-roots.svg"] {
         assert!(dir.path().join(f).exists(), "{f}");
     }
 }
