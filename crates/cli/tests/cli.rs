@@ -1387,8 +1387,9 @@ fn oma_refuses_the_real_chatter_record() {
 /// (cutting conditions not recorded): the spindle speed is estimated from the clip's harmonic
 /// comb at 5496 rpm (91.6 Hz; its lines 91.5, 366.7, 732.8, 1007.4, 1099.5 Hz are multiples 1, 4,
 /// 8, 11, 12, checked with a separate Welch spectrum), written as the cut's `speed_rpm` and named
-/// in its note, and the cut is stable, as labelled. Skipped with a message when the data are
-/// absent.
+/// in its note, and the cut is stable, as labelled. The chatter clip is chatter at 1067.6 Hz
+/// (the cut's dominant line; the background tone at 2329.9 Hz before and after the cut is a
+/// reference stretch). Skipped with a message when the data are absent.
 #[test]
 fn detect_estimates_the_speed_of_a_sound_clip() {
     let Some(clip) = real_data("milling_chatter_record/metalcutting_nochatter8058.mp3") else {
@@ -1414,6 +1415,33 @@ fn detect_estimates_the_speed_of_a_sound_clip() {
     let note = cut["note"].as_str().unwrap();
     assert!(
         note.contains("speed estimated from the harmonic comb"),
+        "{note}"
+    );
+    // the chatter clip: its background before and after the cut is a reference stretch, and
+    // the cut's dominant line is the chatter (chatter_oma tests/detection.rs)
+    let Some(clip) = real_data("milling_chatter_record/combined_chatter6567.mp3") else {
+        return;
+    };
+    let obs = one_signal_observations(
+        dir.path(),
+        &clip,
+        r#""speed_rpm": 1000, "depth_mm": 1, "quantity": "sound""#,
+    );
+    let out = succeed(chatter().args([
+        "detect",
+        "--estimate-speed",
+        "--observations",
+        obs.to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cut = &json["cuts"][0];
+    assert_eq!(cut["stable"], false, "{cut}");
+    let f = cut["chatter_hz"].as_f64().unwrap();
+    assert!((1062.0..=1072.0).contains(&f), "{cut}");
+    let note = cut["note"].as_str().unwrap();
+    assert!(
+        note.contains("reference stretch without the cut")
+            && note.contains("carrying over half of the cut's power"),
         "{note}"
     );
 }

@@ -782,6 +782,21 @@ fn flip_lines(
     })
 }
 
+/// A window's strongest non-synchronous line and the window's band power.
+#[derive(Debug, Clone, Copy)]
+struct WindowLine {
+    /// Bin of the peak.
+    peak: usize,
+    /// Refined frequency (Hz).
+    line_hz: f64,
+    /// Peak density over the window's floor (dB).
+    line_to_floor_db: f64,
+    /// The line's power over the rest of the band (dB).
+    line_to_rest_db: f64,
+    /// Band power of the window (standardized units).
+    power: f64,
+}
+
 /// Powers (density less the floor, times the bin width) of the line (the non-synchronous bins
 /// within 2 of its peak), of the synchronous bins and of the rest of the band.
 struct LineShares {
@@ -803,9 +818,13 @@ impl LineShares {
         let above = |i: usize| (psd[i] - floor).max(0.0) * df;
         let near = |i: usize| i.abs_diff(peak) <= 2;
         let (mut line, mut sync, mut rest) = (0.0, 0.0, 0.0);
-        for i in first.min(peak.saturating_sub(2))..=last.max(peak + 2).min(psd.len() - 1) {
+        let (start, end) = (
+            first.min(peak.saturating_sub(2)),
+            last.max(peak + 2).min(psd.len() - 1),
+        );
+        for (i, &sync_bin) in synchronous.iter().enumerate().take(end + 1).skip(start) {
             let inside = (first..=last).contains(&i);
-            match (synchronous[i], near(i)) {
+            match (sync_bin, near(i)) {
                 (false, true) => line += above(i),
                 (true, _) if inside => sync += above(i),
                 (false, false) if inside => rest += above(i),
@@ -906,9 +925,8 @@ fn judge_windows(
     }
     let count = (segment_psd.len() - per_window) / hop + 1;
     let half = segment / 2;
-    // each window's line first (cheap: the densities are there): (peak bin, line Hz, dB over
-    // the floor, dB over the rest of the band, the band's power)
-    let lines: Vec<Option<(usize, f64, f64, f64, f64)>> = (0..count)
+    // each window's line first (cheap: the densities are there)
+    let lines: Vec<Option<WindowLine>> = (0..count)
         .into_par_iter()
         .map(|w| {
             let psd = mean_density(&segment_psd[w * hop..w * hop + per_window]);
@@ -916,40 +934,46 @@ fn judge_windows(
             let line_to_floor_db = 10.0 * (psd[peak] / floor.max(f64::MIN_POSITIVE)).log10();
             let shares = LineShares::new(&psd, synchronous, floor, peak, (first, last), df);
             let power = psd[first..=last].iter().sum::<f64>() * df;
-            Some((
+            Some(WindowLine {
                 peak,
-                refine_peak_hz(&psd, peak, df),
+                line_hz: refine_peak_hz(&psd, peak, df),
                 line_to_floor_db,
-                shares.to_rest_db(),
+                line_to_rest_db: shares.to_rest_db(),
                 power,
-            ))
+            })
         })
         .collect();
     // the reference stretch: windows near the quietest when the record holds much louder ones
-    let powers = lines.iter().flatten().map(|l| l.4);
+    let powers = lines.iter().flatten().map(|l| l.power);
     let quietest = powers.clone().fold(f64::INFINITY, f64::min);
     let contrast_db = 10.0 * (powers.fold(0.0, f64::max) / quietest.max(f64::MIN_POSITIVE)).log10();
     let has_reference = contrast_db >= REFERENCE_CONTRAST_DB;
     let reference = |w: usize| {
         has_reference
-            && lines[w].is_some_and(|l| l.4 <= quietest * 10f64.powf(REFERENCE_LEVEL_DB / 10.0))
+            && lines[w].is_some_and(|l| l.power <= quietest * 10f64.powf(REFERENCE_LEVEL_DB / 10.0))
     };
     // the line's variation only where it can matter: the line stands out of the floor and a
     // neighbouring window has it too, both cutting
     let stands = |w: usize| {
         lines[w]
-            .filter(|l| l.2 >= MIN_LINE_TO_FLOOR_DB)
+            .filter(|l| l.line_to_floor_db >= MIN_LINE_TO_FLOOR_DB)
             .filter(|_| !reference(w))
     };
     let paired = |a: usize, b: usize| {
         stands(a)
             .zip(stands(b))
-            .is_some_and(|(x, y)| (x.1 - y.1).abs() <= LINE_MATCH_BINS * df)
+            .is_some_and(|(x, y)| (x.line_hz - y.line_hz).abs() <= LINE_MATCH_BINS * df)
     };
     let judged: Vec<(WindowJudgement, usize)> = (0..count)
         .into_par_iter()
         .filter_map(|w| {
-            let (peak, line_hz, line_to_floor_db, line_to_rest_db, _) = lines[w]?;
+            let WindowLine {
+                peak,
+                line_hz,
+                line_to_floor_db,
+                line_to_rest_db,
+                ..
+            } = lines[w]?;
             let start = w * hop * half;
             let needed = (w > 0 && paired(w - 1, w)) || (w + 1 < count && paired(w, w + 1));
             let variation = needed.then(|| {
