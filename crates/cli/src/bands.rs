@@ -55,7 +55,8 @@ pub struct BandRequest<'a> {
     pub samples: Option<usize>,
     /// Seed of the Monte Carlo draws when given (default 0).
     pub seed: Option<u64>,
-    /// Perturbation bounds of this central credibility of |mu| (None: |E mu| +- sd).
+    /// Perturbation bounds of this central credibility of |mu| (None: the mean modulus +- one
+    /// standard deviation of the complex multiplier).
     pub coverage: Option<f64>,
     /// Observed cuts.
     pub observations: Option<&'a Path>,
@@ -196,7 +197,7 @@ pub fn bands(req: &BandRequest) -> Result<()> {
     let obs = req.observations.map(inputs::observations).transpose()?;
     let speeds = match speeds {
         Some(s) => s,
-        None => chatter_stability::boundary::default_speeds_rpm(&model),
+        None => chatter_stability::speed_grid::lobe_speeds_rpm(&model),
     };
     if let Some(offset) = req.offsets.0 {
         let span = speeds.last().unwrap_or(&0.0) - speeds.first().unwrap_or(&0.0);
@@ -253,7 +254,7 @@ fn geometric(
         .and_then(Path::file_stem)
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "bands".into());
-    let extra = theta_distance_svgs(&stem, &bands)?;
+    let extra = offset_detail_svgs(&stem, &bands)?;
     if let Some(path) = req.plot {
         for (name, svg) in &extra {
             write_atomic(&path.with_file_name(name), svg.as_bytes())?;
@@ -335,10 +336,14 @@ pub fn geometric_csv(bands: &OffsetBoundaries) -> String {
     csv
 }
 
-/// 001 Figs. 7-10: Eq. 2's angle theta and Eq. 1's offset distance d along the mean boundary,
-/// as SVG texts named after the band plot `stem`: `STEM-theta.svg` and `STEM-distance.svg`
-/// (`bands --plot F.svg` writes them beside the plot).
-pub fn theta_distance_svgs(stem: &str, bands: &OffsetBoundaries) -> Result<[(String, String); 2]> {
+/// 001 Figs. 6-10: Eq. 2's angle theta and Eq. 1's offset distance d along the mean boundary,
+/// and the raw Eq. 10-11 roots of every point (unmodified, cusp gaps and loops included) beside
+/// the mean boundary, as SVG texts named after the band plot `stem`: `STEM-theta.svg`,
+/// `STEM-distance.svg` and `STEM-roots.svg` (`bands --plot F.svg` writes them beside the plot).
+pub fn offset_detail_svgs(stem: &str, bands: &OffsetBoundaries) -> Result<[(String, String); 3]> {
+    let points = |f: fn(&chatter_uncertainty::geometric::PointOffset) -> (f64, f64)| {
+        bands.points.iter().map(f).collect::<Vec<_>>()
+    };
     let series = |label: &str, f: fn(&chatter_uncertainty::geometric::PointOffset) -> f64| {
         [Series {
             label: label.into(),
@@ -347,11 +352,17 @@ pub fn theta_distance_svgs(stem: &str, bands: &OffsetBoundaries) -> Result<[(Str
             dashed: false,
         }]
     };
+    let dots = |label: &str, points: Vec<(f64, f64)>, color: RGBColor| Series {
+        label: label.into(),
+        points,
+        color,
+        dashed: true,
+    };
     Ok([
         (
             format!("{stem}-theta.svg"),
             line_chart_svg(
-                "Boundary angle along the mean boundary (001 Eq. 2)",
+                "Angle theta of the mean boundary against spindle speed (Schmitz 2023 Eq. 2)",
                 "spindle speed (rpm)",
                 "theta (deg)",
                 &series("theta", |p| p.theta_deg),
@@ -361,10 +372,29 @@ pub fn theta_distance_svgs(stem: &str, bands: &OffsetBoundaries) -> Result<[(Str
         (
             format!("{stem}-distance.svg"),
             line_chart_svg(
-                "Offset distance along the mean boundary (001 Eq. 1)",
+                "Offset distance d against spindle speed (Schmitz 2023 Eq. 1)",
                 "spindle speed (rpm)",
                 "d (rpm / um units)",
                 &series("d", |p| p.distance),
+                None,
+            )?,
+        ),
+        (
+            format!("{stem}-roots.svg"),
+            line_chart_svg(
+                "Offset points of every boundary point: the two roots of Schmitz 2023 Eq. 10-11",
+                "spindle speed (rpm)",
+                "axial depth (mm)",
+                &[
+                    Series {
+                        label: "mean boundary".into(),
+                        points: points(|p| (p.speed_rpm, p.depth_mm)),
+                        color: BLUE,
+                        dashed: false,
+                    },
+                    dots("upper root", points(|p| p.upper), GREEN),
+                    dots("lower root", points(|p| p.lower), RGBColor(200, 0, 0)),
+                ],
                 None,
             )?,
         ),
@@ -465,12 +495,17 @@ fn perturbation(
 /// Plot title of a bound rule.
 pub fn rule_title(rule: BoundRule) -> String {
     match rule {
-        BoundRule::ComplexSd => "|E mu| +- 1 sd of complex mu (000 Sec. 6.4)".into(),
+        BoundRule::ComplexSd => {
+            "bounds where the dominant multiplier's mean modulus +- one standard deviation \
+             reaches 1"
+                .into()
+        }
         BoundRule::Coverage(c) => format!("{:.0} % credibility of |mu|", 100.0 * c),
     }
 }
 
-/// Credibility bounds (000 Eq. 14-18, [`band_jobs::perturbation`]) under `rule` as CSV
+/// Credibility bounds (second-order perturbation of the dominant multiplier, Ahmadi 2022 Eq.
+/// 14-18, [`band_jobs::perturbation`]) under `rule` as CSV
 /// `speed_rpm,depth_mm,lower_mm,upper_mm` (empty cells where a contour is not reached on the
 /// grid) and the plot series, broken (NaN) at those speeds so no line is drawn across a gap.
 pub fn credibility_bands(
@@ -496,14 +531,14 @@ pub fn credibility_bands(
     };
     let (mean, lower, upper) = match rule {
         BoundRule::ComplexSd => (
-            "mean |E mu| = 1".to_string(),
-            "lower: |E mu| + sd = 1".to_string(),
-            "upper: |E mu| - sd = 1".to_string(),
+            "limit of the mean multiplier".to_string(),
+            "lower: mean + 1 sd reaches 1".to_string(),
+            "upper: mean - 1 sd reaches 1".to_string(),
         ),
         BoundRule::Coverage(c) => {
             let p = 100.0 * c;
             (
-                "mean E|mu| = 1".to_string(),
+                "limit of the mean modulus".to_string(),
                 format!("lower ({p:.0} %)"),
                 format!("upper ({p:.0} %)"),
             )

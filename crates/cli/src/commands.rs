@@ -10,8 +10,6 @@ use chatter_dynamics::{ModalModel, Observations};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 pub use chatter_stability::prepared::Method;
-use chatter_stability::zero_order::zoa_lobes;
-use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
 use plotters::style::BLUE;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -384,15 +382,23 @@ pub fn multiplier(
     Ok(())
 }
 
+/// Title of the demo's credibility plot (and its caption in the report page).
+pub const CREDIBILITY_TITLE: &str = "Turning tool of Ahmadi (2022) after updating: limit at the \
+     posterior mean, bounds where the dominant multiplier's mean modulus +- 1 sd reaches 1";
+
 /// What `--out` of `chatter demo` may hold (the folder of its previous run).
-pub const DEMO_FILES: [&str; 13] = [
+pub const DEMO_FILES: [&str; 17] = [
     "papers.csv",
     "turning_lobes.csv",
     "turning_lobes.svg",
     "eq34_covariance.json",
     "turning_credibility.csv",
     "turning_credibility.svg",
+    "milling_bands.csv",
     "milling_bands.svg",
+    "milling_bands-theta.svg",
+    "milling_bands-distance.svg",
+    "milling_bands-roots.svg",
     "milling_frf.csv",
     "shopfloor_model.json",
     "shopfloor_observations.json",
@@ -414,7 +420,10 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     };
 
     // 1. Turning case of seed 000: lobes (FDM and exact ZOA) over the tested speeds with the cuts.
-    stage(1, "turning lobes of seed 000");
+    stage(
+        1,
+        "turning lobes of the Ahmadi (2022) tool and its test cuts",
+    );
     let turning = examples::ahmadi_2022_turning();
     let obs = examples::ahmadi_2022_turning_observations();
     let speeds: Vec<f64> = (0..=120).map(|i| 6800.0 + 7.5 * i as f64).collect();
@@ -423,7 +432,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     folder.add(
         "turning_lobes.svg",
         line_chart_svg(
-            "Turning tool of 000 (Table 1 hammer modes): FDM lobes and test cuts",
+            "Turning tool of Ahmadi (2022), hammer-test modes: FDM lobes and test cuts",
             "spindle speed (rpm)",
             "width of cut (mm)",
             &[Series {
@@ -469,7 +478,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     folder.add(
         "turning_credibility.svg",
         line_chart_svg(
-            "Turning tool of 000 after updating: lobes at the Eq. 34 posterior mean, |E mu| +- 1 sd",
+            CREDIBILITY_TITLE,
             "spindle speed (rpm)",
             "width of cut (mm)",
             &series,
@@ -478,21 +487,22 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     );
 
     // 3. Milling example of seed 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm).
-    stage(3, "milling lobes of seed 001 with Type B offsets");
+    stage(
+        3,
+        "milling lobes with speed and depth offsets (Schmitz 2023)",
+    );
     let milling = examples::schmitz_2023_milling();
-    let speeds: Vec<f64> = (0..=1000).map(|i| 4000.0 + 10.0 * i as f64).collect();
-    let zoa = zoa_lobes(&milling, &speeds)?;
-    let curve: Vec<(f64, f64)> = zoa
+    let bands = chatter_uncertainty::geometric::schmitz2023::example_boundaries()?;
+    let curve: Vec<(f64, f64)> = bands
+        .points
         .iter()
-        .filter(|p| p.depth_m.is_finite())
-        .map(|p| (p.speed_rpm, p.depth_mm()))
+        .map(|p| (p.speed_rpm, p.depth_mm))
         .collect();
-    let bands = type_b_offsets(&curve, TypeBOffsets::new(100.0, 0.2)?)?;
     folder.add("milling_bands.csv", crate::bands::geometric_csv(&bands));
     folder.add(
         "milling_bands.svg",
         line_chart_svg(
-            "Milling example of 001: zero-order lobes with Type B offsets (100 rpm, 0.2 mm)",
+            "Milling example of Schmitz (2023): zero-order lobes offset by 100 rpm and 0.2 mm",
             "spindle speed (rpm)",
             "axial depth (mm)",
             &crate::bands::band_series(
@@ -504,7 +514,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             None,
         )?,
     );
-    for (name, svg) in crate::bands::theta_distance_svgs("milling_bands", &bands)? {
+    for (name, svg) in crate::bands::offset_detail_svgs("milling_bands", &bands)? {
         folder.add(name, svg);
     }
     folder.add("milling_frf.csv", frf_csv(&milling, 0.0, 1500.0, 301, 0, 0));
@@ -512,9 +522,9 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     // 4. The seeds' published numbers beside ours, with tolerances.
     stage(
         4,
-        "the papers' numbers beside ours (000 Table 3, 001 lobe extremes, 003 Table 2)",
+        "the papers' numbers beside ours (000 Table 3, 001 Sec. 4, 003 Table 2)",
     );
-    let rows = crate::papers::rows(&zoa)?;
+    let rows = crate::papers::rows(&bands)?;
     folder.add("papers.csv", crate::papers::csv(&rows));
     summary.insert(
         "papers".into(),
@@ -577,8 +587,8 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     let page = crate::report::jobs::demo(
         &folder,
         &[
-            ("turning tool of 000 (Table 1 hammer modes)", &turning),
-            ("milling example of 001", &milling),
+            ("turning tool of Ahmadi (2022), hammer-test modes", &turning),
+            ("milling example of Schmitz (2023)", &milling),
             ("shop-floor machine: the nominal model diagnosed", &nominal),
         ],
         &diagnosis,

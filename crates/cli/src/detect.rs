@@ -22,8 +22,9 @@
 //! With `--model` of a milling machine, its tooth count is used: with an even count, lines at
 //! the odd multiples of half the tooth-passing frequency are judged for period-doubling (flip)
 //! chatter (`chatter_oma::detection`, "Flip chatter"). Records long enough for two windows are
-//! also judged window by window (chatter in part of a record; "Windows"); the note gives the
-//! chattering span or the windows' margin.
+//! also judged window by window (chatter in part of a record; "Windows"), leaving out a
+//! reference stretch without the cut when the record holds one ("Reference stretch"); the note
+//! gives the chattering span or the windows' margin.
 //!
 //! Interference (mains hum): by default a comb of lines at the multiples of a 45-65 Hz
 //! fundamental is searched for (`chatter_oma::interference`) and its lines are left out; the
@@ -245,13 +246,27 @@ fn windows_note(d: &Detection) -> String {
     let Some(w) = &d.evidence.windows else {
         return "; record shorter than 1.5 windows: judged whole".into();
     };
+    let reference = if w.reference_stretch {
+        let quiet = w.windows.iter().filter(|j| j.reference).count();
+        format!(
+            ", {quiet} of them a reference stretch without the cut ({:.1} dB quieter), not judged",
+            w.contrast_db
+        )
+    } else {
+        String::new()
+    };
     let frame = format!(
-        "{} windows of {:.2} s (chatter counts from {:.2} s)",
+        "{} windows of {:.2} s (chatter counts from {:.2} s){reference}",
         w.windows.len(),
         w.window_s,
         w.min_duration_s
     );
     match (&w.chatter, w.margin) {
+        (Some(c), _) if c.by_dominance => format!(
+            "; {frame}: chatter at {:.1} Hz from {:.1} to {:.1} s, a line carrying over half \
+             of the cut's power (V {:.2})",
+            c.line_hz, c.start_s, c.end_s, c.line_variation
+        ),
         (Some(c), Some(m)) => format!(
             "; {frame}: chatter at {:.1} Hz from {:.1} to {:.1} s (V {:.2}, margin {m:+.3})",
             c.line_hz, c.start_s, c.end_s, c.line_variation

@@ -144,7 +144,8 @@ enum Command {
         /// Stability method; default zoa for geometric, fdm otherwise.
         #[arg(long, value_enum)]
         method: Option<Method>,
-        /// Speeds MIN:MAX:N (rpm).
+        /// Speeds MIN:MAX:N (rpm); default as `lobes`: lobe numbers ~1 to 12 of the dominant
+        /// mode, 20 speeds per lobe (200-2000 speeds) so no lobe is aliased.
         #[arg(long)]
         speeds: Option<String>,
         /// Depths MIN:MAX:N (mm) of the perturbation grid or the probability map; default 0 to
@@ -177,7 +178,8 @@ enum Command {
         #[arg(long)]
         seed: Option<u64>,
         /// Perturbation: bounds of this central credibility of |mu| (e.g. 0.95) instead of the
-        /// paper's |E mu| +- one standard deviation of the complex mu.
+        /// default: the depths where the dominant multiplier's mean modulus plus (lower bound) or
+        /// minus (upper bound) one standard deviation of the complex multiplier reaches 1.
         #[arg(long)]
         coverage: Option<f64>,
         /// Observed cuts to draw.

@@ -5,7 +5,7 @@
 use anyhow::Result;
 use chatter_dynamics::examples;
 use chatter_progress::Silent;
-use chatter_stability::boundary::LobePoint;
+use chatter_uncertainty::geometric::{OffsetBoundaries, schmitz2023};
 use chatter_uncertainty::sensitivity::{TransitionMap, pole_sensitivity};
 use chatter_updating::karandikar;
 use std::fmt::Write as _;
@@ -67,36 +67,19 @@ fn ahmadi_table_3() -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// 001 Sec. 3: the zero-order lobes' maxima near 5660 and 11298 rpm and the minimum near
-/// 6960 rpm, located on `lobes` (the demo's 10 rpm grid), each within 1 % of the speed.
-fn schmitz_lobe_extremes(lobes: &[LobePoint]) -> Vec<Row> {
-    let finite: Vec<(f64, f64)> = lobes
-        .iter()
-        .filter(|p| p.depth_m.is_finite())
-        .map(|p| (p.speed_rpm, p.depth_m))
-        .collect();
-    let extreme = |near: f64, max: bool| -> f64 {
-        finite
-            .iter()
-            .filter(|(s, _)| (s - near).abs() <= 0.05 * near)
-            .max_by(|a, b| {
-                let (x, y) = if max { (a.1, b.1) } else { (b.1, a.1) };
-                x.total_cmp(&y)
-            })
-            .map_or(f64::NAN, |p| p.0)
-    };
-    [(5660.0, true), (11298.0, true), (6960.0, false)]
+/// 001 Sec. 4: the stated results of the numerical example (lobe extremes, theta and d there,
+/// the Eq. 10-11 roots) on `bands`, the example's offsets
+/// ([`schmitz2023::example_boundaries`]), with the tolerances of [`schmitz2023::checks`].
+fn schmitz_section_4(bands: &OffsetBoundaries) -> Vec<Row> {
+    schmitz2023::checks(bands)
         .into_iter()
-        .map(|(near, max)| Row {
-            source: "001 Sec. 3".into(),
-            quantity: format!(
-                "speed of the lobe {} near {near} rpm (rpm)",
-                if max { "maximum" } else { "minimum" }
-            ),
-            paper: near,
-            ours: extreme(near, max),
-            tolerance: 0.01 * near,
-            reproduced_by: "chatter lobes --method zoa on examples/schmitz2023_milling_model.json",
+        .map(|c| Row {
+            source: "001 Sec. 4".into(),
+            quantity: c.quantity,
+            paper: c.paper,
+            ours: c.ours,
+            tolerance: c.tolerance,
+            reproduced_by: "cargo run --release -p chatter-uncertainty --example schmitz2023",
         })
         .collect()
 }
@@ -131,11 +114,11 @@ fn karandikar_table_2() -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// All rows: 000 Table 3, 001's lobe extremes on `milling_lobes` (the zero-order lobes of the
-/// 001 example), 003 Table 2.
-pub fn rows(milling_lobes: &[LobePoint]) -> Result<Vec<Row>> {
+/// All rows: 000 Table 3, 001 Sec. 4 on `milling_bands` (the offsets of the 001 example), 003
+/// Table 2.
+pub fn rows(milling_bands: &OffsetBoundaries) -> Result<Vec<Row>> {
     let mut rows = ahmadi_table_3()?;
-    rows.extend(schmitz_lobe_extremes(milling_lobes));
+    rows.extend(schmitz_section_4(milling_bands));
     rows.extend(karandikar_table_2()?);
     Ok(rows)
 }

@@ -187,6 +187,7 @@ fn demo_writes_its_folder() {
         "milling_bands.csv",
         "milling_bands-theta.svg",
         "milling_bands-distance.svg",
+        "milling_bands-roots.svg",
         "eq34_covariance.json",
         "turning_credibility.csv",
         "turning_credibility.svg",
@@ -201,7 +202,7 @@ fn demo_writes_its_folder() {
     // the report page, in a real browser: every plot drawn, the verdicts in words with units
     let page = dir.path().join("report.html");
     let html = std::fs::read_to_string(&page).unwrap();
-    assert_eq!(html.matches("<figure>").count(), 7);
+    assert_eq!(html.matches("<figure>").count(), 8);
     browser::check(
         &page,
         &[
@@ -222,9 +223,20 @@ fn demo_writes_its_folder() {
             .unwrap();
     assert_eq!(summary["turning_limits"].as_array().unwrap().len(), 4);
     assert_eq!(summary["diagnosis"]["verdict"], "process_damping");
-    // 000 Table 3 (15), 001 lobe extremes (3), 003 Table 2 (8); only D's reduction is outside
-    assert_eq!(summary["papers"]["rows"], 26);
-    assert_eq!(summary["papers"]["within_tolerance"], 25);
+    // 000 Sec. 6.4: credibility bounds on every row, lower <= mean <= upper, and at 7300 rpm
+    // they bracket the test cuts (stable at 3.048 mm below, chatter at 3.81 mm above)
+    let credibility = std::fs::read_to_string(dir.path().join("turning_credibility.csv")).unwrap();
+    for line in credibility.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        assert!(v[2] <= v[1] && v[1] <= v[3], "{line}");
+        if v[0] == 7300.0 {
+            assert!(v[2] > 3.048 && v[3] < 3.81, "{line}");
+        }
+    }
+    assert!(credibility.lines().any(|l| l.starts_with("7300,")));
+    // 000 Table 3 (15), 001 Sec. 4 (15), 003 Table 2 (8); only D's reduction is outside
+    assert_eq!(summary["papers"]["rows"], 38);
+    assert_eq!(summary["papers"]["within_tolerance"], 37);
 }
 
 #[test]
@@ -1439,8 +1451,9 @@ fn oma_refuses_the_real_chatter_record() {
 /// (cutting conditions not recorded): the spindle speed is estimated from the clip's harmonic
 /// comb at 5496 rpm (91.6 Hz; its lines 91.5, 366.7, 732.8, 1007.4, 1099.5 Hz are multiples 1, 4,
 /// 8, 11, 12, checked with a separate Welch spectrum), written as the cut's `speed_rpm` and named
-/// in its note, and the cut is stable, as labelled. Skipped with a message when the data are
-/// absent.
+/// in its note, and the cut is stable, as labelled. The chatter clip is chatter at 1067.6 Hz
+/// (the cut's dominant line; the background tone at 2329.9 Hz before and after the cut is a
+/// reference stretch). Skipped with a message when the data are absent.
 #[test]
 fn detect_estimates_the_speed_of_a_sound_clip() {
     let Some(clip) = real_data("milling_chatter_record/metalcutting_nochatter8058.mp3") else {
@@ -1466,6 +1479,33 @@ fn detect_estimates_the_speed_of_a_sound_clip() {
     let note = cut["note"].as_str().unwrap();
     assert!(
         note.contains("speed estimated from the harmonic comb"),
+        "{note}"
+    );
+    // the chatter clip: its background before and after the cut is a reference stretch, and
+    // the cut's dominant line is the chatter (chatter_oma tests/detection.rs)
+    let Some(clip) = real_data("milling_chatter_record/combined_chatter6567.mp3") else {
+        return;
+    };
+    let obs = one_signal_observations(
+        dir.path(),
+        &clip,
+        r#""speed_rpm": 1000, "depth_mm": 1, "quantity": "sound""#,
+    );
+    let out = succeed(chatter().args([
+        "detect",
+        "--estimate-speed",
+        "--observations",
+        obs.to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cut = &json["cuts"][0];
+    assert_eq!(cut["stable"], false, "{cut}");
+    let f = cut["chatter_hz"].as_f64().unwrap();
+    assert!((1062.0..=1072.0).contains(&f), "{cut}");
+    let note = cut["note"].as_str().unwrap();
+    assert!(
+        note.contains("reference stretch without the cut")
+            && note.contains("carrying over half of the cut's power"),
         "{note}"
     );
 }
@@ -1586,7 +1626,7 @@ fn geometric_bands_export_raw_roots_and_theta_distance_plots() {
         "speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance,upper_speed_rpm,\
          upper_depth_mm,lower_speed_rpm,lower_depth_mm\n"
     ));
-    for f in ["b.svg", "b-theta.svg", "b-distance.svg"] {
+    for f in ["b.svg", "b-theta.svg", "b-distance.svg", "b-roots.svg"] {
         assert!(dir.path().join(f).exists(), "{f}");
     }
 }

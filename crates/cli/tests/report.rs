@@ -64,7 +64,11 @@ fn bands_and_plan_pages_render_with_their_figures() {
             .arg(&bands),
     );
     let html = check_sections(&bands);
-    assert_eq!(html.matches("<figure>").count(), 3, "band, theta, distance");
+    assert_eq!(
+        html.matches("<figure>").count(),
+        4,
+        "band, theta, distance, raw roots"
+    );
     browser::check(
         &bands,
         &[

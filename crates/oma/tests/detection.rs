@@ -480,9 +480,11 @@ fn chatter_in_part_of_a_record_is_found_by_the_windows() {
         let d = detect(&stable, &options).unwrap();
         let w = d.evidence.windows.clone().unwrap();
         eprintln!(
-            "seed {seed}, no episode: {:?}, windows margin {:?}, {} windows of {:.2} s",
+            "seed {seed}, no episode: {:?}, windows margin {:?}, contrast {:.1} dB, {} windows \
+             of {:.2} s",
             d.verdict,
             w.margin,
+            w.contrast_db,
             w.windows.len(),
             w.window_s
         );
@@ -493,8 +495,15 @@ fn chatter_in_part_of_a_record_is_found_by_the_windows() {
             let w = d.evidence.windows.clone().unwrap();
             for j in &w.windows {
                 eprintln!(
-                    "  window {:5.2} s: line {:7.1} Hz, {:5.1} dB, V {:?}, margin {:?}",
-                    j.start_s, j.line_hz, j.line_to_floor_db, j.line_variation, j.margin
+                    "  window {:5.2} s: line {:7.1} Hz, {:5.1} dB, {:+5.1} dB over the rest, V \
+                     {:?}, margin {:?}, reference {}",
+                    j.start_s,
+                    j.line_hz,
+                    j.line_to_floor_db,
+                    j.line_to_rest_db,
+                    j.line_variation,
+                    j.margin,
+                    j.reference
                 );
             }
             let span = w.chatter.clone().unwrap();
@@ -654,16 +663,21 @@ fn real_record_test255_is_chatter() {
 ///   V 0.318, margin -0.018).
 ///   Window by window (5.94 s windows) it stays stable: its line 739.7 Hz has V 0.54 and
 ///   0.32 in its two windows.
-/// - `combined_chatter6567.mp3`: the verdict is printed, **not asserted**, because it is right
-///   for a reason that is not the chatter. Its 1067 Hz line is present only from about 3 to 20 s
-///   (short-time spectra); the whole-record criterion judges the second half (31-63 s), where
-///   the clip holds a stationary background without that line (V 0.81: stable). Window by
-///   window, the 1067-1077 Hz line is the strongest from 3 to 21 s, but its V is 2.35, 1.32,
-///   0.67, 0.62, 1.92 (onset, drifting 1077 -> 1067 Hz, end): never two neighbouring chattering
-///   windows. What the windows do find is a constant tone at 2329.9 Hz (V 0.09-0.17) from 17.8 s
-///   to the end, one of the background's lines (the first window, before the cut, has another,
-///   1770.7 Hz, V 0.14): a stationary non-harmonic tone is a limit cycle to this criterion, so
-///   the clip is labelled chatter at 2329.9 Hz. See the signals6 note.
+/// - `combined_chatter6567.mp3`: the cut lasts from about 5 to 18 s of 63 s (short-time
+///   spectra, scipy: band power 8-10 dB over the rest of the clip, whose strongest lines 2331.0,
+///   869.4, 1771.1 and 215.3 Hz are the same, at the same levels, before and after the cut).
+///   Judged whole it is stable (its second half, 31-63 s, is that background). Window by
+///   window, before the reference stretch (module docs) was built, it was labelled chatter at
+///   2329.9 Hz, a stationary background tone (V 0.09-0.17 from 17.8 s to the end) and not a
+///   spindle or tooth harmonic (the cut's comb is 215.3 Hz: 2329.9 / 215.3 = 10.82). Now: the
+///   windows before and after the cut are its reference stretch, not judged; the cut's windows
+///   carry the 1067-1077 Hz line (V 2.35, 1.32, 0.67, 0.62, 1.92: no two neighbouring limit
+///   cycles) at +2.0, +3.9 and +1.0 dB over the rest of the band from 8.9 s: chatter by
+///   dominance at 1067.6 Hz from 8.9 to 20.8 s, asserted within 1062-1072 Hz (scipy's
+///   short-time spectra put the line at 1076.7, 1068.6, 1065.9 and 1068.6 Hz in 3 s blocks from
+///   6 to 18 s, with sidebands 215.3 Hz away; the cut's comb 215.3, 430.7, 646.0, 861.3 Hz puts
+///   its 5th multiple at 1076.5 Hz, near the onset's line, so the range excludes it), and the
+///   background tone is no longer chatter (every window from 18 s is reference).
 #[test]
 fn real_mp3_clips_with_the_speed_unknown() {
     let dir = concat!(
@@ -701,20 +715,52 @@ fn real_mp3_clips_with_the_speed_unknown() {
         if let Some(w) = &e.windows {
             for j in &w.windows {
                 eprintln!(
-                    "  window {:5.1} s: line {:7.1} Hz, {:5.1} dB over floor, V {:?}, margin {:?}",
-                    j.start_s, j.line_hz, j.line_to_floor_db, j.line_variation, j.margin
+                    "  window {:5.1} s: line {:7.1} Hz, {:5.1} dB over floor, {:+5.1} dB over \
+                     the rest, V {:?}, margin {:?}, reference {}, dominant {}",
+                    j.start_s,
+                    j.line_hz,
+                    j.line_to_floor_db,
+                    j.line_to_rest_db,
+                    j.line_variation,
+                    j.margin,
+                    j.reference,
+                    j.dominant
                 );
             }
             eprintln!(
-                "  windows of {:.2} s, at least {:.2} s: margin {:?}, chatter {:?}",
-                w.window_s, w.min_duration_s, w.margin, w.chatter
+                "  windows of {:.2} s, at least {:.2} s, contrast {:.1} dB: margin {:?}, chatter \
+                 {:?}",
+                w.window_s, w.min_duration_s, w.contrast_db, w.margin, w.chatter
+            );
+        }
+        if file.contains("combined") {
+            let w = e.windows.as_ref().unwrap();
+            assert!(w.reference_stretch, "{w:?}");
+            assert_eq!(d.verdict, Verdict::Chatter, "{e:?}");
+            let f = d.chatter_hz.unwrap();
+            // the chatter of the middle of the cut, not the 5th multiple of the cut's 215.3 Hz
+            // comb (1076.5 Hz), which the onset windows' line lies near
+            assert!((1062.0..=1072.0).contains(&f), "chatter at {f} Hz");
+            let span = w.chatter.as_ref().unwrap();
+            assert!(
+                span.by_dominance && span.start_s >= 0.0 && span.end_s <= 24.0,
+                "{span:?}"
+            );
+            assert!(
+                w.windows
+                    .iter()
+                    .filter(|j| j.start_s > 18.0)
+                    .all(|j| j.reference),
+                "{w:?}"
             );
         }
         if file.contains("nochatter") {
             assert!((e.fundamental_hz - 91.6).abs() < 0.1, "{e:?}");
             assert_eq!(d.verdict, Verdict::Stable, "{e:?}");
             assert!(
-                e.windows.as_ref().is_some_and(|w| w.chatter.is_none()),
+                e.windows
+                    .as_ref()
+                    .is_some_and(|w| w.chatter.is_none() && !w.reference_stretch),
                 "{e:?}"
             );
         }

@@ -22,6 +22,8 @@
 
 use crate::error::{Result, UncertaintyError};
 
+pub mod schmitz2023;
+
 /// Depth scale that makes rpm and depth comparable, as in 001: micrometres per millimetre.
 pub const DEPTH_SCALE_UM_PER_MM: f64 = 1000.0;
 

@@ -659,13 +659,20 @@ fn caption_of(name: &str) -> Option<&'static str> {
             "Cuts at their depth over the nominal limit: circles above 1 and crosses below 1 \
              disagree with the nominal model"
         }
-        "turning_lobes.svg" => "Turning tool of 000: FDM lobes and the test cuts",
-        "turning_credibility.svg" => {
-            "Turning tool of 000 after updating: lobes at the Eq. 34 posterior mean, |E mu| +- 1 sd"
+        "turning_lobes.svg" => "Turning tool of Ahmadi (2022): FDM lobes and the test cuts",
+        "turning_credibility.svg" => crate::commands::CREDIBILITY_TITLE,
+        "milling_bands.svg" => {
+            "Milling example of Schmitz (2023): zero-order lobes offset by 100 rpm and 0.2 mm"
         }
-        "milling_bands.svg" => "Milling example of 001: zero-order lobes with Type B offsets",
-        "milling_bands-theta.svg" => "Boundary angle theta along the mean boundary (001 Eq. 2)",
-        "milling_bands-distance.svg" => "Offset distance d along the mean boundary (001 Eq. 1)",
+        "milling_bands-theta.svg" => {
+            "Angle theta of the mean boundary against spindle speed (Schmitz 2023 Eq. 2)"
+        }
+        "milling_bands-distance.svg" => {
+            "Offset distance d against spindle speed (Schmitz 2023 Eq. 1)"
+        }
+        "milling_bands-roots.svg" => {
+            "The two roots of Schmitz 2023 Eq. 10-11 at every point of the mean boundary"
+        }
         _ => return None,
     })
 }
@@ -830,8 +837,9 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
     page.command_line_inputs();
     page.input(
         "examples",
-        "seed 000 turning tool (Table 1 hammer modes, test cuts, Eq. 34 posterior); seed 001 \
-         milling example; a synthetic shop-floor campaign with withheld process damping",
+        "the turning tool of Ahmadi (2022) (its hammer-test modes, test cuts and posterior); the \
+         milling example of Schmitz (2023); a synthetic shop-floor campaign with withheld \
+         process damping",
     );
     for (label, m) in models {
         page.model(label, m);
@@ -844,21 +852,21 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
     };
     band_findings(
         &mut page,
-        "Turning tool of 000 (FDM lobes)",
+        "Turning tool of Ahmadi (2022) (FDM lobes)",
         &text("turning_lobes.csv"),
         "",
         LOBES_MISSING,
     );
     band_findings(
         &mut page,
-        "Turning tool of 000 after updating (Eq. 34)",
+        "Turning tool of Ahmadi (2022) after updating (credibility bounds)",
         &text("turning_credibility.csv"),
         "lower credibility bound",
         PERTURBATION_MISSING,
     );
     band_findings(
         &mut page,
-        "Milling example of 001 (Type B offsets 100 rpm, 0.2 mm)",
+        "Milling example of Schmitz (2023) (offsets 100 rpm, 0.2 mm)",
         &text("milling_bands.csv"),
         "lower offset boundary",
         GEOMETRIC_MISSING,
@@ -880,6 +888,7 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
         "milling_bands.svg",
         "milling_bands-theta.svg",
         "milling_bands-distance.svg",
+        "milling_bands-roots.svg",
         "diagnosis/lobes.svg",
         "diagnosis/residuals.svg",
     ] {
