@@ -522,7 +522,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     // 4. The seeds' published numbers beside ours, with tolerances.
     stage(
         4,
-        "the papers' numbers beside ours (000 Table 3, 001 Sec. 4, 003 Table 2)",
+        "the papers' numbers beside ours (000 Table 3, 001 Sec. 4, 003 Table 2, 004)",
     );
     let rows = crate::papers::rows(&bands)?;
     folder.add("papers.csv", crate::papers::csv(&rows));

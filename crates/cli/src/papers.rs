@@ -7,7 +7,7 @@ use chatter_dynamics::examples;
 use chatter_progress::Silent;
 use chatter_uncertainty::geometric::{OffsetBoundaries, schmitz2023};
 use chatter_uncertainty::sensitivity::{TransitionMap, pole_sensitivity};
-use chatter_updating::karandikar;
+use chatter_updating::{karandikar, schmitz2022};
 use std::fmt::Write as _;
 
 /// One published number and ours.
@@ -114,12 +114,30 @@ fn karandikar_table_2() -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// 004 (Sec. 6-7): the MRR and chatter frequency of the tests the paper reports, the RCSA prior
+/// as `plan` draws it and the first planned cut's P_s at P_test 0.25 / 0.5 / 0.75, with the
+/// tolerances of [`schmitz2022::reproduction`] (200 prior paths, seed 4).
+fn schmitz_2022() -> Result<Vec<Row>> {
+    Ok(schmitz2022::reproduction(200, 4, &Silent)?
+        .into_iter()
+        .map(|r| Row {
+            source: "004".into(),
+            quantity: r.quantity,
+            paper: r.paper,
+            ours: r.ours,
+            tolerance: r.tolerance,
+            reproduced_by: "cargo test -p chatter-updating --test schmitz2022 -- --nocapture",
+        })
+        .collect())
+}
+
 /// All rows: 000 Table 3, 001 Sec. 4 on `milling_bands` (the offsets of the 001 example), 003
-/// Table 2.
+/// Table 2, 004.
 pub fn rows(milling_bands: &OffsetBoundaries) -> Result<Vec<Row>> {
     let mut rows = ahmadi_table_3()?;
     rows.extend(schmitz_section_4(milling_bands));
     rows.extend(karandikar_table_2()?);
+    rows.extend(schmitz_2022()?);
     Ok(rows)
 }
 

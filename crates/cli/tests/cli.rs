@@ -235,8 +235,8 @@ fn demo_writes_its_folder() {
     }
     assert!(credibility.lines().any(|l| l.starts_with("7300,")));
     // 000 Table 3 (15), 001 Sec. 4 (15), 003 Table 2 (8); only D's reduction is outside
-    assert_eq!(summary["papers"]["rows"], 38);
-    assert_eq!(summary["papers"]["within_tolerance"], 37);
+    assert_eq!(summary["papers"]["rows"], 49);
+    assert_eq!(summary["papers"]["within_tolerance"], 48);
 }
 
 #[test]
