@@ -153,6 +153,12 @@ pub const MIN_SEGMENT_SHARE: f64 = 0.5;
 /// chain) and 17-38 dB (noise floor) below the peak; 20 dB is also a factor of 10 in amplitude,
 /// the line factor of [`crate::harmonics::LINE_FACTOR`].
 pub const NOISE_FLOOR_DB: f64 = 20.0;
+/// Structural clusters whose spectral prominence (height over the median density,
+/// [`crate::support`]) is below this many dB are in the noise floor too: the highest bin of a
+/// density of white noise stands about 2 dB over its median with 32 Welch segments; 6 dB is
+/// four times the floor's power. It is the test that refuses lifted (milling) records whose
+/// measurement noise buries the response.
+pub const MIN_PROMINENCE_DB: f64 = 6.0;
 
 /// Lifting of time-periodic (milling) signals before identification.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -341,7 +347,7 @@ pub enum Rejection {
     /// A spectral line of the record (forced response or limit cycle).
     SpectralLine,
     /// In the noise floor: spectral support more than [`NOISE_FLOOR_DB`] below the highest
-    /// resonance peak.
+    /// resonance peak, or prominence below [`MIN_PROMINENCE_DB`].
     NoiseFloor,
     /// Found in too few segments.
     Segments {
@@ -501,10 +507,8 @@ impl Prepared {
                 let band_hz = (LOWER_EDGE_FRACTION * top, (1.0 - UPPER_EDGE_FRACTION) * top);
                 // a record without power off its lines has no resonance to support a pole:
                 // the noise-floor test and the ranking are then left out
-                let support = SpectralSupport::new(&data, rate, band_hz, &excluded_hz, |f| {
-                    lines.is_line(f)
-                })
-                .ok();
+                let support =
+                    SpectralSupport::new(&data, rate, band_hz, &excluded_hz, Some(&lines)).ok();
                 let skip_lags = if factor > 1 {
                     options.skip_lags.max(correlation_support_lags(factor))
                 } else {
@@ -544,6 +548,15 @@ impl Prepared {
                     data.extend((0..nv).map(|k| lifted[k * r / nv].clone()));
                 }
                 let nv = l.virtual_sensors;
+                // the support of the lifted record with its periodic response removed (as in
+                // the correlations): the noise-floor test, not the ranking
+                let rate = 1.0 / l.period_s;
+                let fluctuations: Vec<Vec<f64>> = data
+                    .iter()
+                    .map(|ch| remove_class_means(ch, l.periods_per_revolution))
+                    .collect();
+                let support =
+                    SpectralSupport::new(&fluctuations, rate, (0.0, 0.5 * rate), &[], None).ok();
                 Ok(with_segments(Self {
                     data,
                     interval_s: l.period_s,
@@ -556,7 +569,7 @@ impl Prepared {
                     factor: 1,
                     band_hz: (0.0, f64::INFINITY),
                     lines: None,
-                    support: None,
+                    support,
                     segment_len: 0,
                 }))
             }
@@ -585,19 +598,7 @@ impl Prepared {
         let window: Vec<Vec<f64>> = self
             .data
             .iter()
-            .map(|ch| {
-                let w = &ch[start..start + len];
-                let means: Vec<f64> = (0..classes)
-                    .map(|k| {
-                        let class = w.iter().skip(k).step_by(classes);
-                        class.clone().sum::<f64>() / class.count().max(1) as f64
-                    })
-                    .collect();
-                w.iter()
-                    .enumerate()
-                    .map(|(i, v)| v - means[i % classes])
-                    .collect()
-            })
+            .map(|ch| remove_class_means(&ch[start..start + len], classes))
             .collect();
         let max_lag = lags + skip;
         Ok(if self.lifted {
@@ -677,14 +678,16 @@ impl Prepared {
         }
         self.support
             .as_ref()
-            .is_some_and(|s| s.level_db(f) < -NOISE_FLOOR_DB)
+            .is_some_and(|s| {
+                s.level_db(f) < -NOISE_FLOOR_DB || s.prominence_db(f) < MIN_PROMINENCE_DB
+            })
             .then_some(Rejection::NoiseFloor)
     }
 
     /// The persistent clusters of `structural` by rank (step 4 of the module documentation).
     fn ranked(&self, structural: Vec<PoleCluster>) -> Vec<PoleCluster> {
         let mut kept = ranked(structural);
-        if let Some(s) = &self.support {
+        if let (Some(s), false) = (&self.support, self.lifted) {
             // stable sort: equal supports keep the decay-rate order
             kept.sort_by(|a, b| s.level_db(b.frequency_hz).total_cmp(&s.level_db(a.frequency_hz)));
         }
@@ -763,6 +766,20 @@ impl Prepared {
                     .total_cmp(&(b.lambda - target).norm())
             })
     }
+}
+
+/// `w` less the mean of each residue class of its samples modulo `classes`.
+fn remove_class_means(w: &[f64], classes: usize) -> Vec<f64> {
+    let means: Vec<f64> = (0..classes)
+        .map(|k| {
+            let class = w.iter().skip(k).step_by(classes);
+            class.clone().sum::<f64>() / class.count().max(1) as f64
+        })
+        .collect();
+    w.iter()
+        .enumerate()
+        .map(|(i, v)| v - means[i % classes])
+        .collect()
 }
 
 /// ", rejected: 4823.6 Hz (band edge), ..." or nothing.
@@ -891,6 +908,7 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
         let spectral_peak = prepared
             .support
             .as_ref()
+            .filter(|_| !prepared.lifted)
             .and_then(|s| s.peak(estimate.frequency_hz));
         return Ok(Identification {
             estimate,

@@ -1,5 +1,6 @@
 //! Spectral support of a pole: how high the record's power spectral density stands at its
-//! frequency, against the highest peak of the response that is not a forced line.
+//! frequency, against the highest peak of the response that is not a forced line and against
+//! the density's floor.
 //!
 //! A stabilization cluster is a pole of the correlation model; whether the record's response
 //! actually has power there is a separate question, answered by the Welch densities S_c(f) of
@@ -10,14 +11,35 @@
 //! band outside the excluded frequencies (spindle multiples and spectral lines: forced
 //! responses and limit cycles, which are not resonances), each excluded over
 //! [`LINE_HALF_WIDTH_BINS`] density bins on either side. The support of a pole of frequency f
-//! and damping ratio zeta is
+//! is
 //!
-//!   L(f) = 10 log10( max { S(g) : |g - f| <= max(zeta f, [`PEAK_HALF_WIDTH_BINS`] df) } / S_ref )
+//!   L(f) = 10 log10( max { S(g) : |g - f| <= [`PEAK_HALF_WIDTH_BINS`] df } / S_ref )
 //!
-//! in dB (df the density's bin width): the height of the spectral peak the pole makes, zero for
-//! the highest resonance peak of the record, negative below it.
+//! in dB (df the density's bin width): the height of the spectrum at the pole, zero for the
+//! highest resonance peak of the record, negative below it. The window is not widened by the
+//! pole's bandwidth: a heavily damped pole (the envelope of several close roots that a low
+//! model order fits as one) would then borrow the height of a neighbouring sharp peak. The
+//! prominence is the same height against the floor S_floor, the median of S over the bins
+//! S_ref is taken from: P(f) = L(f) + 10 log10(S_ref / S_floor). A density without resonances
+//! (white measurement noise, as in a lifted record where the noise buries the response) has P
+//! of about 2 dB at its highest bin (the Welch scatter with 32 segments or more is
+//! 1 / sqrt(32) = 18 % per bin).
+//!
+//! # Spectral peak (half-power estimate)
+//! [`SpectralSupport::peak`] reads the local maximum of S nearest a pole (within
+//! [`PEAK_SEARCH_FRACTION`] of its frequency) as an independent estimate of the pole: its
+//! frequency f_p by a parabola through the log densities of the three top bins, and its damping
+//! ratio by the half-power bandwidth, zeta = B / (2 f_p), with B the distance between the
+//! frequencies where S falls to half the peak (linear interpolation between bins) and the Hann
+//! window's own half-power width (1.44 bins) removed in quadrature,
+//! B = sqrt(B_measured^2 - (1.44 df)^2) (a Gaussian approximation of the convolution with the
+//! window's main lobe). For a single lightly damped mode the half-power bandwidth is
+//! 2 zeta f_n (Ewins, Modal Testing, Sec. 4.3); neighbouring poles closer than a few bandwidths
+//! and the Welch estimate's scatter (relative standard deviation 1 / sqrt(segments) per bin)
+//! make it a cross-check rather than a general estimator.
 
 use crate::error::{OmaError, Result};
+use crate::harmonics::LineSpectrum;
 use crate::spectrum::{power_spectral_density, refine_peak_hz};
 use serde::{Deserialize, Serialize};
 
@@ -66,18 +88,21 @@ pub struct SpectralSupport {
     reference: f64,
     /// Frequency of the reference peak (Hz).
     reference_hz: f64,
+    /// S_floor.
+    floor: f64,
 }
 
 impl SpectralSupport {
     /// The support of `data` (equal-length channels at `sample_rate_hz`) in `band_hz`, the
-    /// frequencies within [`LINE_HALF_WIDTH_BINS`] of `excluded_hz` or where `is_line` holds left
-    /// out of the reference peak.
+    /// frequencies within [`LINE_HALF_WIDTH_BINS`] of `excluded_hz` or of a spectral line of
+    /// `lines` (a local maximum of the density with a line of the record within a bin) left out
+    /// of the reference peak and the floor.
     pub fn new(
         data: &[Vec<f64>],
         sample_rate_hz: f64,
         band_hz: (f64, f64),
         excluded_hz: &[f64],
-        is_line: impl Fn(f64) -> bool,
+        lines: Option<&LineSpectrum>,
     ) -> Result<Self> {
         let l = data.first().map_or(0, Vec::len);
         let mut segment_len = MAX_SEGMENT_LEN;
@@ -103,21 +128,36 @@ impl SpectralSupport {
                 density.iter_mut().zip(&s).for_each(|(d, v)| *d += v / mean);
             }
         }
+        let mut excluded = excluded_hz.to_vec();
+        if let Some(lines) = lines {
+            for k in 1..bins.saturating_sub(1) {
+                if in_band(k) && density[k] >= density[k - 1] && density[k] >= density[k + 1] {
+                    let g = lines.strongest_near(k as f64 * bin_hz, bin_hz);
+                    if lines.is_line(g) {
+                        excluded.push(g);
+                    }
+                }
+            }
+        }
         let near_excluded = |f: f64| {
-            excluded_hz
+            excluded
                 .iter()
                 .any(|h| (f - h).abs() <= LINE_HALF_WIDTH_BINS * bin_hz)
         };
-        let (reference_k, reference) = density
+        let kept: Vec<(usize, f64)> = density
             .iter()
             .enumerate()
             .filter(|(k, _)| in_band(*k))
-            .filter(|(k, _)| {
-                let f = *k as f64 * bin_hz;
-                !near_excluded(f) && !is_line(f)
-            })
-            .fold((0, 0.0), |best, (k, v)| if *v > best.1 { (k, *v) } else { best });
-        if !(reference > 0.0) {
+            .filter(|(k, _)| !near_excluded(*k as f64 * bin_hz))
+            .map(|(k, v)| (k, *v))
+            .collect();
+        let (reference_k, reference) = kept
+            .iter()
+            .fold((0, 0.0), |best, &(k, v)| if v > best.1 { (k, v) } else { best });
+        let mut values: Vec<f64> = kept.iter().map(|(_, v)| *v).collect();
+        values.sort_by(f64::total_cmp);
+        let floor = values.get(values.len() / 2).copied().unwrap_or(0.0);
+        if !(reference > 0.0 && floor > 0.0) {
             return Err(OmaError::InvalidInput {
                 field: "signals",
                 message: format!(
@@ -132,6 +172,7 @@ impl SpectralSupport {
             density,
             reference,
             reference_hz: reference_k as f64 * bin_hz,
+            floor,
         })
     }
 
@@ -150,6 +191,11 @@ impl SpectralSupport {
             .map(|k| self.density[k])
             .fold(0.0, f64::max);
         10.0 * (peak / self.reference).log10()
+    }
+
+    /// P(f) in dB at `frequency_hz`: the height over the floor (module documentation).
+    pub fn prominence_db(&self, frequency_hz: f64) -> f64 {
+        self.level_db(frequency_hz) + 10.0 * (self.reference / self.floor).log10()
     }
 
     /// The resonance peak nearest `frequency_hz` (module documentation, "Spectral peak"):
