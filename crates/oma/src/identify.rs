@@ -689,7 +689,10 @@ impl Prepared {
         let mut kept = ranked(structural);
         if let (Some(s), false) = (&self.support, self.lifted) {
             // stable sort: equal supports keep the decay-rate order
-            kept.sort_by(|a, b| s.level_db(b.frequency_hz).total_cmp(&s.level_db(a.frequency_hz)));
+            kept.sort_by(|a, b| {
+                s.level_db(b.frequency_hz)
+                    .total_cmp(&s.level_db(a.frequency_hz))
+            });
         }
         kept
     }

@@ -151,9 +151,11 @@ impl SpectralSupport {
             .filter(|(k, _)| !near_excluded(*k as f64 * bin_hz))
             .map(|(k, v)| (k, *v))
             .collect();
-        let (reference_k, reference) = kept
-            .iter()
-            .fold((0, 0.0), |best, &(k, v)| if v > best.1 { (k, v) } else { best });
+        let (reference_k, reference) =
+            kept.iter().fold(
+                (0, 0.0),
+                |best, &(k, v)| if v > best.1 { (k, v) } else { best },
+            );
         let mut values: Vec<f64> = kept.iter().map(|(_, v)| *v).collect();
         values.sort_by(f64::total_cmp);
         let floor = values.get(values.len() / 2).copied().unwrap_or(0.0);
@@ -179,8 +181,12 @@ impl SpectralSupport {
     /// The bins within `half_width_hz` of `frequency_hz`.
     fn bins_near(&self, frequency_hz: f64, half_width_hz: f64) -> std::ops::RangeInclusive<usize> {
         let last = self.density.len() - 1;
-        let lo = ((frequency_hz - half_width_hz) / self.bin_hz).ceil().max(0.0) as usize;
-        let hi = ((frequency_hz + half_width_hz) / self.bin_hz).floor().max(0.0) as usize;
+        let lo = ((frequency_hz - half_width_hz) / self.bin_hz)
+            .ceil()
+            .max(0.0) as usize;
+        let hi = ((frequency_hz + half_width_hz) / self.bin_hz)
+            .floor()
+            .max(0.0) as usize;
         lo.min(last)..=hi.min(last).max(lo.min(last))
     }
 

@@ -9,8 +9,8 @@
 //! [`chatter_oma::synthetic`] (matrix exponential) or the crate under test.
 #![allow(clippy::unwrap_used)]
 
-use chatter_oma::signals::Signals;
 use chatter_oma::identify::Rejection;
+use chatter_oma::signals::Signals;
 use chatter_oma::{Harmonics, IdentifyOptions, identify};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};

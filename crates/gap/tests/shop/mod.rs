@@ -140,29 +140,29 @@ pub fn observe(nominal: &ModalModel, scenario: &Scenario, poles: bool) -> Observ
                 let e = id.estimate;
                 let (frequency_hz, damping_ratio, frequency_std_hz, damping_std, repetitions) =
                     if milling {
-                    (
-                        e.principal_frequency_hz,
-                        e.damping_ratio,
-                        e.frequency_std_hz,
-                        e.damping_std,
-                        u32::try_from(e.repetitions).ok(),
-                    )
-                } else {
-                    match id.spectral_peak {
-                        Some(p) if (p.frequency_hz / e.frequency_hz - 1.0).abs() <= 0.01 => {
-                            // one spectrum: no spread over repetitions, the noise model's applies
-                            (p.frequency_hz, p.damping_ratio, None, None, None)
-                        }
-                        _ => {
-                            eprintln!(
-                                "pole at {:.0} rpm: LSCE {:.1} Hz without a spectral peak \
+                        (
+                            e.principal_frequency_hz,
+                            e.damping_ratio,
+                            e.frequency_std_hz,
+                            e.damping_std,
+                            u32::try_from(e.repetitions).ok(),
+                        )
+                    } else {
+                        match id.spectral_peak {
+                            Some(p) if (p.frequency_hz / e.frequency_hz - 1.0).abs() <= 0.01 => {
+                                // one spectrum: no spread over repetitions, the noise model's applies
+                                (p.frequency_hz, p.damping_ratio, None, None, None)
+                            }
+                            _ => {
+                                eprintln!(
+                                    "pole at {:.0} rpm: LSCE {:.1} Hz without a spectral peak \
                                  within 1 %, skipped",
-                                test.speed_rpm, e.frequency_hz
-                            );
-                            continue;
+                                    test.speed_rpm, e.frequency_hz
+                                );
+                                continue;
+                            }
                         }
-                    }
-                };
+                    };
                 obs.poles.push(PoleObservation {
                     speed_rpm: test.speed_rpm,
                     depth_mm: test.depth_m * 1e3,
