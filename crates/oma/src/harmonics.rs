@@ -120,6 +120,26 @@ impl LineSpectrum {
         }
     }
 
+    /// The frequency of the grid point within `half_width_hz` of `frequency_hz` where the
+    /// amplitude of some channel is highest: where a line seen in a coarser spectrum is.
+    pub fn strongest_near(&self, frequency_hz: f64, half_width_hz: f64) -> f64 {
+        let lo = ((frequency_hz - half_width_hz) / self.grid_hz)
+            .ceil()
+            .max(0.0) as usize;
+        let hi = ((frequency_hz + half_width_hz) / self.grid_hz)
+            .floor()
+            .max(0.0) as usize;
+        let best = self
+            .amplitudes
+            .iter()
+            .flat_map(|amp| (lo..=hi.min(amp.len().saturating_sub(1))).map(move |k| (k, amp[k])))
+            .fold(
+                (lo, f64::NEG_INFINITY),
+                |b, (k, v)| if v > b.1 { (k, v) } else { b },
+            );
+        best.0 as f64 * self.grid_hz
+    }
+
     /// Whether `frequency_hz` is a line in at least one channel: its amplitude exceeds
     /// [`LINE_FACTOR`] times the median over [`LINE_NEIGHBOURS`] frequencies on each side,
     /// [`LINE_SPACING_BINS`] record bins apart.

@@ -23,6 +23,7 @@
 //! - [`lifting`]: lifting of time-periodic signals at their period (002 Eq. 6-7).
 //! - [`stabilization`]: stabilization diagrams over model orders.
 //! - [`picking`]: automatic choice of the dominant structural pole.
+//! - [`support`]: spectral support of a pole (its PSD peak against the highest resonance peak).
 //! - [`spectrum`]: first singular value of the cross-PSD matrix; Welch densities.
 //! - [`detection`]: chatter detection, self-excited lines against the harmonics of a
 //!   fundamental.
@@ -56,6 +57,7 @@ pub mod polyreference;
 pub mod signals;
 pub mod spectrum;
 pub mod stabilization;
+pub mod support;
 pub mod synthetic;
 
 pub use error::{OmaError, Result};
