@@ -14,6 +14,9 @@ pub enum BayesError {
     /// The sampler could not proceed (e.g. every likelihood is zero).
     #[error("{0}")]
     Degenerate(String),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

@@ -16,7 +16,7 @@ use chatter_bayes::tmcmc::{
     TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, rejuvenate, tmcmc,
 };
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_progress::{Observer, Silent};
+use chatter_progress::Observer;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::Discretization;
 use rand::SeedableRng;
@@ -358,7 +358,7 @@ pub(crate) fn log_likelihood(
     }
 }
 
-/// Fit one class to `data` by iTMCMC.
+/// Fit one class to `data` by iTMCMC; `observer` hears of its stages and may cancel it.
 pub(crate) fn fit<'a>(
     class: EffectClass,
     nominal: &'a Nominal,
@@ -366,16 +366,20 @@ pub(crate) fn fit<'a>(
     options: &DiagnoseOptions,
     samples: usize,
     seed: u64,
+    observer: &dyn Observer,
 ) -> Result<Fitted<'a>> {
     let model = ClassModel::new(class, nominal)?;
     let samples = (samples as f64 * class.population_factor()).round() as usize;
     let count = FailureCount::default();
     let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta, &count);
     let run =
-        tmcmc(&model.prior, &like, &options.tmcmc(samples, seed), &Silent).map_err(|source| {
-            GapError::Sampler {
-                class: class.name(),
-                source,
+        tmcmc(&model.prior, &like, &options.tmcmc(samples, seed), observer).map_err(|source| {
+            match source {
+                chatter_bayes::BayesError::Cancelled(c) => GapError::Cancelled(c),
+                source => GapError::Sampler {
+                    class: class.name(),
+                    source,
+                },
             }
         })?;
     let (evaluations, failures) = count.get();
@@ -603,6 +607,7 @@ pub fn diagnose(
             &options,
             options.samples,
             class_seed(options.seed, class, 0),
+            observer,
         )?;
         observer.class_done(class.name(), f.run.log_evidence);
         fitted.push(f);

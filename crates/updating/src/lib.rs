@@ -8,6 +8,7 @@
 //! | [`milling`] | identified Floquet multipliers (frequency, damping) against the exact discretized monodromy operator, sigma_zeta = alpha sigma_w | 002 Eq. 13-15 |
 //! | [`cuts`] | stable / chatter results with chatter frequency; the one-sided kernel | 004 Eq. 5, 003 Eq. 3-4 |
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
+//! | [`sampled`] | sampled stability boundaries (limits and chatter frequencies per sample and speed, probabilities, failures), P_s maps and quantile bands | 003 Eq. 7, 004 Eq. 8, Fig. 2 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
 //! | [`karandikar`] | 003's prior, Table 2's candidate tests with the paper's numbers, RSS identification of C | 003 |
 //! | [`surrogate`] | Matérn GP surrogate of the dominant milling multiplier, with its error against the exact one | 002 Section 2.2 |
@@ -48,6 +49,7 @@ pub mod milling;
 pub mod parameters;
 pub mod plan;
 pub mod prior_bounds;
+pub mod sampled;
 pub mod surrogate;
 pub mod turning;
 pub mod update;
