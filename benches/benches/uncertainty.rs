@@ -1,7 +1,8 @@
 //! Uncertainty speed: the second-order perturbation moments (000 Eq. 15-18) on a 200 x 100
 //! speed x depth grid of the single-DOF benchmark (FDM, m = 40), and a 1000-sample Monte Carlo
 //! probability-of-stability map (004 Fig. 2) of the same benchmark over 50 speeds (the prepared
-//! FDM at the automatic resolution on the nominal grid, as `chatter bands --kind montecarlo`).
+//! FDM at each sample's automatic resolution, extrapolated, as `chatter bands --kind
+//! montecarlo`).
 use chatter_dynamics::{Parameter, examples};
 use chatter_stability::boundary::{BoundaryOptions, speed_range};
 use chatter_stability::monodromy::Discretization;

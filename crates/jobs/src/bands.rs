@@ -178,9 +178,9 @@ impl MonteCarloBands {
 }
 
 /// `samples` draws of the distribution (seeded), the boundary of each at every speed by the
-/// prepared discretization of `method` on the nominal model's step grid, searched from the
-/// zero-order limit (004; `chatter_updating::sampled::sample_boundaries`); `observer` hears of
-/// each draw.
+/// prepared discretization of `method` at each draw's automatic resolution, Richardson-
+/// extrapolated and searched from the zero-order limit (004;
+/// `chatter_updating::sampled::sample_boundaries`); `observer` hears of each draw.
 pub fn montecarlo(
     model: &ModalModel,
     distribution: &ParameterDistribution,

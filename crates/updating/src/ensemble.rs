@@ -265,7 +265,7 @@ impl BoundaryEnsemble {
                 // information are defined over every path
                 let row = chatter_progress::check(observer)
                     .map_err(UpdatingError::from)
-                    .and_then(|()| boundary_of(&self.options, m, grid, &new))
+                    .and_then(|()| boundary_of(&self.options, m, Some(grid), &new))
                     .and_then(|points| points.into_iter().collect::<Result<Vec<_>>>());
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 observer.steps_done(k, total);
