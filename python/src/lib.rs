@@ -3,8 +3,9 @@
 //! out. Units are in every name (`speed_rpm`, `depth_mm`, `frequency_hz`).
 //!
 //! Long calls run on a worker thread while the calling thread waits without the GIL and checks
-//! for Ctrl-C every 50 ms: an interrupt raises `KeyboardInterrupt` at once (the worker finishes
-//! its current job in the background and its result is dropped).
+//! for Ctrl-C every 50 ms. An interrupt cancels the call inside the libraries (their observer,
+//! `chatter_progress::Observer::cancelled`, is polled between speeds, samples and sampler moves)
+//! and raises `KeyboardInterrupt` once the worker has returned.
 
 use chatter_dynamics::{ModalModel, ModelFile, Observations};
 use chatter_jobs::bands as band_jobs;
@@ -16,26 +17,64 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 /// Any library error as a Python `ValueError` with its message.
 fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// Run `work` on a worker thread; wait without the GIL, checking signals between waits.
+/// The observer of a Python call: silent, and cancelled once the caller was interrupted.
+#[derive(Default)]
+struct Interruptible(AtomicBool);
+
+impl chatter_progress::Observer for Interruptible {
+    fn cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// Worker threads of calls still running (interrupted ones included until they return).
+static RUNNING_WORKERS: AtomicUsize = AtomicUsize::new(0);
+
+/// How long an interrupted call waits for its worker to stop. The libraries poll the
+/// cancellation between steps (a speed, a sample, a sampler move), so the worker normally
+/// returns within milliseconds; a call whose library does not poll (OMA, simulation) is left to
+/// finish in the background after this wait.
+const CANCEL_WAIT: Duration = Duration::from_secs(5);
+
+/// Run `work` on a worker thread with an observer that can cancel it; wait without the GIL,
+/// checking signals every 50 ms. On Ctrl-C the observer asks the library to stop, the call
+/// waits (up to [`CANCEL_WAIT`]) for the worker to return, and `KeyboardInterrupt` is raised.
 fn run_detached<T: Send + 'static>(
     py: Python<'_>,
-    work: impl FnOnce() -> T + Send + 'static,
+    work: impl FnOnce(&dyn chatter_progress::Observer) -> T + Send + 'static,
 ) -> PyResult<T> {
-    let handle = std::thread::spawn(work);
+    let observer = Arc::new(Interruptible::default());
+    let worker_observer = Arc::clone(&observer);
+    RUNNING_WORKERS.fetch_add(1, Ordering::SeqCst);
+    let handle = std::thread::spawn(move || {
+        let result = work(&*worker_observer);
+        RUNNING_WORKERS.fetch_sub(1, Ordering::SeqCst);
+        result
+    });
     loop {
         if handle.is_finished() {
             return handle
                 .join()
                 .map_err(|_| PyRuntimeError::new_err("the chatter worker thread panicked"));
         }
-        py.detach(|| std::thread::sleep(std::time::Duration::from_millis(50)));
+        py.detach(|| std::thread::sleep(Duration::from_millis(50)));
         if let Err(e) = py.check_signals() {
+            observer.0.store(true, Ordering::Relaxed);
+            py.detach(|| {
+                let start = Instant::now();
+                while !handle.is_finished() && start.elapsed() < CANCEL_WAIT {
+                    std::thread::sleep(Duration::from_millis(5));
+                }
+            });
             return Err(if e.is_instance_of::<PyKeyboardInterrupt>(py) {
                 e
             } else {
@@ -43,6 +82,13 @@ fn run_detached<T: Send + 'static>(
             });
         }
     }
+}
+
+/// The number of worker threads of chatter calls still running; 0 right after an interrupted
+/// call whose library stopped on the cancel (what the tests check).
+#[pyfunction]
+fn _running_workers() -> usize {
+    RUNNING_WORKERS.load(Ordering::SeqCst)
 }
 
 /// JSON text of a Python object (a dict) through the `json` module.
@@ -187,8 +233,8 @@ fn lobes<'py>(
     let m = model_of(model)?;
     let method = method_of(method)?;
     let speeds = speeds_of(&m, speeds_rpm)?;
-    let points = run_detached(py, move || {
-        band_jobs::lobes(&m, method, &speeds, &chatter_progress::Silent)
+    let points = run_detached(py, move |observer| {
+        band_jobs::lobes(&m, method, &speeds, observer)
     })?
     .map_err(value_error)?;
     let d = PyDict::new(py);
@@ -223,7 +269,7 @@ fn multiplier<'py>(
             "method \"zoa\" gives limiting depths, not multipliers; use \"fdm\" or \"sdm\"",
         ));
     };
-    let (mu, chatter_hz) = run_detached(py, move || {
+    let (mu, chatter_hz) = run_detached(py, move |_| {
         solver.chatter_frequency_hz(&m, speed_rpm, depth_mm * 1e-3)
     })?
     .map_err(value_error)?;
@@ -257,8 +303,8 @@ fn bands_geometric<'py>(
     let speeds = speeds_of(&m, speeds_rpm)?;
     let offsets = chatter_uncertainty::geometric::TypeBOffsets::new(offset_rpm, offset_mm)
         .map_err(value_error)?;
-    let g = run_detached(py, move || {
-        band_jobs::geometric(&m, method, &speeds, offsets, &chatter_progress::Silent)
+    let g = run_detached(py, move |observer| {
+        band_jobs::geometric(&m, method, &speeds, offsets, observer)
     })?
     .map_err(value_error)?;
     let b = &g.bands;
@@ -368,7 +414,7 @@ fn bands_perturbation<'py>(
         Some(c) => BoundRule::coverage(c).map_err(|e| value_error(format!("coverage: {e}")))?,
         None => BoundRule::ComplexSd,
     };
-    let p = run_detached(py, move || {
+    let p = run_detached(py, move |_| {
         band_jobs::perturbation(&m, &dist, method, rule, &speeds, depths)
     })?
     .map_err(value_error)?;
@@ -418,16 +464,8 @@ fn bands_montecarlo<'py>(
     let depths = map_depths_mm
         .map(|d| d.as_slice().map(<[f64]>::to_vec))
         .transpose()?;
-    let (mc, map) = run_detached(py, move || {
-        let mc = band_jobs::montecarlo(
-            &m,
-            &dist,
-            method,
-            samples,
-            seed,
-            &speeds,
-            &chatter_progress::Silent,
-        )?;
+    let (mc, map) = run_detached(py, move |observer| {
+        let mc = band_jobs::montecarlo(&m, &dist, method, samples, seed, &speeds, observer)?;
         let map = mc.map(depths)?;
         Ok::<_, chatter_jobs::JobError>((mc, map))
     })?
@@ -506,7 +544,7 @@ fn simulate<'py>(
     s.random_force_rms_n = random_force_n;
     s.harmonic_force_n = harmonic_force_n;
     s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
-    let sim = run_detached(py, move || chatter_dynamics::simulate::simulate(&m, &s))?
+    let sim = run_detached(py, move |_| chatter_dynamics::simulate::simulate(&m, &s))?
         .map_err(value_error)?;
     let names: Vec<String> = sim.channels.iter().map(|c| c.name.clone()).collect();
     let rows: Vec<Vec<f64>> = sim.channels.into_iter().map(|c| c.data).collect();
@@ -545,7 +583,7 @@ fn detect<'py>(
     let signals = signals_of(data, sample_rate_hz, names)?;
     let mut options = DetectionOptions::new(speed_rpm / 60.0);
     options.once_per_rev_channel = once_per_rev_channel;
-    let det = run_detached(py, move || {
+    let det = run_detached(py, move |_| {
         chatter_oma::detection::detect(&signals, &options)
     })?
     .map_err(value_error)?;
@@ -578,7 +616,7 @@ fn oma<'py>(
             fundamental_hz: s / 60.0,
         };
     }
-    let id = run_detached(py, move || chatter_oma::identify(&signals, &options))?
+    let id = run_detached(py, move |_| chatter_oma::identify(&signals, &options))?
         .map_err(value_error)?;
     let e = &id.estimate;
     let d = PyDict::new(py);
@@ -588,6 +626,83 @@ fn oma<'py>(
     d.set_item("damping_std", e.damping_std)?;
     d.set_item("repetitions", e.repetitions)?;
     d.set_item("order", id.order)?;
+    Ok(d)
+}
+
+/// Operational modal analysis of every signal record of an observations file or dict (the
+/// `chatter oma --observations FILE` job, `chatter_jobs::oma`): each record is checked by chatter
+/// detection (a chattering record is refused unless `allow_chatter`), then its dominant pole is
+/// identified (modified LSCE with the spindle harmonics; lifted polyreference at the tooth period
+/// with a milling `model`). Returns ``observations`` (the command's JSON: the input's cuts and
+/// one pole per record) and numpy arrays over the records: ``speed_rpm``, ``frequency_hz``,
+/// ``damping_ratio``, ``frequency_std_hz``, ``damping_std`` (NaN where not estimated).
+/// `harmonics_hz`: None for the spindle lines, [] for none, else the lines to impose (Hz);
+/// `interference_hz`: None to search a mains comb, [] for none, else the fundamentals (Hz).
+#[pyfunction]
+#[pyo3(signature = (observations, model=None, min_order=None, max_order=None, segments=None,
+    harmonics_hz=None, decimation=None, interference_hz=None, allow_chatter=false))]
+#[allow(clippy::too_many_arguments)]
+fn oma_observations<'py>(
+    py: Python<'py>,
+    observations: &Bound<'py, PyAny>,
+    model: Option<&Bound<'py, PyAny>>,
+    min_order: Option<usize>,
+    max_order: Option<usize>,
+    segments: Option<usize>,
+    harmonics_hz: Option<Vec<f64>>,
+    decimation: Option<usize>,
+    interference_hz: Option<Vec<f64>>,
+    allow_chatter: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    use chatter_oma::interference::Interference;
+    let o = observations_of(observations)?;
+    let m = model.map(model_of).transpose()?;
+    let request = chatter_jobs::oma::OmaRequest {
+        min_order,
+        max_order,
+        segments,
+        harmonics: harmonics_hz.map(|h| {
+            if h.is_empty() {
+                chatter_oma::Harmonics::None
+            } else {
+                chatter_oma::Harmonics::Known(h)
+            }
+        }),
+        decimation,
+        interference: match interference_hz {
+            None => Interference::default(),
+            Some(f) if f.is_empty() => Interference::Off,
+            Some(f) => Interference::Known(f),
+        },
+        allow_chatter,
+    };
+    let (result, _) = run_detached(py, move |_| {
+        chatter_jobs::oma::identify_observations(&o, m.as_ref(), &request)
+    })?
+    .map_err(value_error)?;
+    let poles = &result.poles;
+    let d = PyDict::new(py);
+    d.set_item("observations", from_json(py, &result.to_json_string())?)?;
+    d.set_item(
+        "speed_rpm",
+        array(py, poles.iter().map(|p| p.speed_rpm).collect()),
+    )?;
+    d.set_item(
+        "frequency_hz",
+        array(py, poles.iter().map(|p| p.frequency_hz).collect()),
+    )?;
+    d.set_item(
+        "damping_ratio",
+        array(py, poles.iter().map(|p| p.damping_ratio).collect()),
+    )?;
+    d.set_item(
+        "frequency_std_hz",
+        array(py, column(poles.iter().map(|p| p.frequency_std_hz))),
+    )?;
+    d.set_item(
+        "damping_std",
+        array(py, column(poles.iter().map(|p| p.damping_std))),
+    )?;
     Ok(d)
 }
 
@@ -662,8 +777,8 @@ fn update<'py>(
     };
     let prepared =
         chatter_jobs::update::PreparedUpdate::new(&m, &o, request).map_err(value_error)?;
-    let (outcome, pointwise) = run_detached(py, move || {
-        let outcome = prepared.run(&chatter_progress::Silent)?;
+    let (outcome, pointwise) = run_detached(py, move |observer| {
+        let outcome = prepared.run(observer)?;
         let pointwise = if pointwise {
             let r = &outcome.result;
             Some(
@@ -691,6 +806,7 @@ fn update<'py>(
     d.set_item("classes", to_py(py, &r.classes)?)?;
     d.set_item("selected_alpha", r.selected_alpha)?;
     d.set_item("prior_bound_pileups", to_py(py, &r.prior_bound_pileups)?)?;
+    d.set_item("warnings", chatter_jobs::update::warnings(r))?;
     d.set_item("surrogate", to_py(py, &r.surrogate)?)?;
     d.set_item("pole_table", to_py(py, &r.pole_table)?)?;
     d.set_item(
@@ -752,13 +868,17 @@ fn plan<'py>(
     request.feed_per_tooth_mm = feed_per_tooth_mm;
     request.seed = seed;
     request.max_tests = max_tests;
-    let outcome = run_detached(py, move || {
-        chatter_jobs::plan::plan(&m, &o, &request, &chatter_progress::Silent)
+    let (outcome, warnings) = run_detached(py, move |observer| {
+        chatter_jobs::plan::plan(&m, &o, &request, observer).map(|outcome| {
+            let warnings = chatter_jobs::plan::warnings(&outcome, &request);
+            (outcome, warnings)
+        })
     })?
     .map_err(value_error)?;
     let mut json = serde_json::to_value(&outcome).map_err(value_error)?;
     if let Some(map) = json.as_object_mut() {
         map.insert("strategy".into(), strategy.into());
+        map.insert("warnings".into(), warnings.into());
     }
     to_py(py, &json)
 }
@@ -799,8 +919,8 @@ fn diagnose<'py>(
         validation: validation_of(validation, folds)?,
         pointwise,
     };
-    let diagnosis = run_detached(py, move || {
-        chatter_jobs::diagnose::diagnose(&m, &o, &request, &chatter_progress::Silent)
+    let diagnosis = run_detached(py, move |observer| {
+        chatter_jobs::diagnose::diagnose(&m, &o, &request, observer)
     })?
     .map_err(value_error)?;
     let out = to_py(py, &diagnosis)?;
@@ -879,7 +999,7 @@ fn run_campaign<'py>(
         observations,
         seed,
     };
-    let result = run_detached(py, move || {
+    let result = run_detached(py, move |_| {
         let row = campaign::run_campaign(&c, &options);
         (c, row)
     })?;
@@ -914,8 +1034,8 @@ fn batch(
 ) -> PyResult<String> {
     let options = campaign_options(samples, paths, validation, folds)?;
     let campaigns = campaign::read_manifest(&manifest).map_err(value_error)?;
-    run_detached(py, move || {
-        campaign::run_batch(&campaigns, &options, &chatter_progress::Silent)
+    run_detached(py, move |observer| {
+        campaign::run_batch(&campaigns, &options, observer)
     })
 }
 
@@ -970,6 +1090,8 @@ fn _chatter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bands_geometric, m)?)?;
     m.add_function(wrap_pyfunction!(bands_perturbation, m)?)?;
     m.add_function(wrap_pyfunction!(bands_montecarlo, m)?)?;
+    m.add_function(wrap_pyfunction!(_running_workers, m)?)?;
+    m.add_function(wrap_pyfunction!(oma_observations, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(detect, m)?)?;
     m.add_function(wrap_pyfunction!(oma, m)?)?;

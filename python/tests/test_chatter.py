@@ -106,6 +106,47 @@ def test_simulated_cuts_are_detected_stable_below_and_chatter_above_the_limit():
     assert verdicts == [True, False]
 
 
+def _stable_and_chattering_records(tmp_path):
+    """Observations listing two simulated turning cuts at 7000 rpm (CSV, with the tachometer):
+    0.3 and 2 times the limiting depth."""
+    speed = 7000.0
+    limit = float(chatter.lobes(TURNING_MODEL, speeds_rpm=np.array([speed]))["depth_mm"][0])
+    entries = []
+    for k, ratio in enumerate((0.3, 2.0)):
+        sim = chatter.simulate(TURNING_MODEL, speed, ratio * limit, duration_s=2.0,
+                               sample_rate_hz=20000.0, seed=1)
+        path = tmp_path / f"cut{k}.csv"
+        with open(path, "w") as f:
+            f.write(",".join(sim["names"]) + "\n")
+            for row in sim["data"].T:
+                f.write(",".join(repr(float(v)) for v in row) + "\n")
+        entries.append({"file": str(path), "speed_rpm": speed, "depth_mm": ratio * limit,
+                        "sample_rate_hz": sim["sample_rate_hz"],
+                        "once_per_rev_channel": "once_per_rev"})
+    return entries
+
+
+def test_oma_of_an_observations_file_equals_the_cli(cli, tmp_path):
+    stable, chattering = _stable_and_chattering_records(tmp_path)
+    obs = tmp_path / "obs.json"
+    obs.write_text(json.dumps({"cuts": [], "signals": [stable]}))
+    text = cli("oma", "--observations", obs, "--model", TURNING_MODEL)
+    py = chatter.oma_observations(obs, model=TURNING_MODEL)
+    assert py["observations"] == json.loads(text)
+    pole = py["observations"]["poles"][0]
+    assert py["frequency_hz"].shape == (1,)
+    assert same(py["frequency_hz"], [pole["frequency_hz"]])
+    assert same(py["damping_ratio"], [pole["damping_ratio"]])
+    assert same(py["speed_rpm"], [7000.0])
+    # the same record as a dict of observations; a chattering record is refused, or flagged
+    both = {"cuts": [], "signals": [stable, chattering]}
+    with pytest.raises(ValueError, match=r"signals\[1\].*chatter detection calls this record"):
+        chatter.oma_observations(both, model=TURNING_MODEL)
+    flagged = chatter.oma_observations(both, model=TURNING_MODEL, allow_chatter=True)
+    assert same(flagged["frequency_hz"][:1], py["frequency_hz"])
+    assert "FLAGGED" in flagged["observations"]["poles"][1]["note"]
+
+
 # --- the same numbers as the command line ---------------------------------------------------
 
 
@@ -177,15 +218,39 @@ def test_geometric_bands_and_plan_are_bit_identical_to_the_cli(cli, tmp_path):
 # --- interruption ---------------------------------------------------------------------------
 
 
-def test_a_long_call_is_interrupted_by_ctrl_c():
-    timer = threading.Timer(0.3, _thread.interrupt_main)
+def _lobes():
+    # about 3 s of work uninterrupted (20 000 speeds)
+    return lambda: chatter.lobes(MILLING_MODEL, speeds_rpm=np.linspace(2000.0, 20000.0, 20000))
+
+
+def _update():
+    # iTMCMC with 20 000 samples per class: a minute and more uninterrupted
+    return lambda: chatter.update(TURNING_MODEL, TURNING_OBSERVATIONS, seed=7, samples=20000,
+                                  pointwise=False)
+
+
+def _diagnose():
+    # the data are made before the timer starts, so that the interrupt lands in the diagnosis
+    model, observations = chatter.synthetic_campaign("process_damping", 2.0, seed=5, cuts=8,
+                                                     pole_speeds=0)
+    return lambda: chatter.diagnose(model, observations, seed=2, samples=4000,
+                                    validation="off", pointwise=False)
+
+
+@pytest.mark.parametrize("make", [_lobes, _update, _diagnose], ids=["lobes", "update", "diagnose"])
+def test_a_long_call_is_cancelled_inside_the_library_by_ctrl_c(make):
+    """Ctrl-C raises KeyboardInterrupt, and the library stopped: the call waits for its worker
+    after asking it to cancel, so no worker is left running (a library that did not poll the
+    cancel would keep its worker busy for seconds to minutes)."""
+    call = make()
+    timer = threading.Timer(0.5, _thread.interrupt_main)
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        # about 3 s of work per call uninterrupted (20 000 speeds), ten times the timer; a few
-        # calls in a row, so that a timer delayed on a loaded machine still lands inside one
+        # a few calls in a row, so that a timer delayed on a loaded machine still lands inside one
         for _ in range(10):
-            chatter.lobes(MILLING_MODEL, speeds_rpm=np.linspace(2000.0, 20000.0, 20000))
+            call()
     timer.join()
+    assert chatter._chatter._running_workers() == 0
 
 
 # --- ArviZ ----------------------------------------------------------------------------------

@@ -291,6 +291,7 @@ impl<P: Prior, L: LogLikelihood> Sampler<'_, P, L> {
         // index in chain.points of u_last, once it has been drawn
         let mut current_point: Option<usize> = None;
         while chain.points.len() < quota {
+            chatter_progress::check(self.observer)?;
             if chain.steps == options.max_steps {
                 return Err(BayesError::Degenerate(format!(
                     "chain {index}: {} of {quota} unique samples after {} steps",

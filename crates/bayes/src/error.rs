@@ -18,6 +18,9 @@ pub enum BayesError {
     /// The sampler could not proceed (a singular covariance, no end of the tempering).
     #[error("{0}")]
     Degenerate(String),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

@@ -76,21 +76,13 @@ impl SampleSet {
     }
     /// Weighted quantile of one coordinate.
     pub fn quantile(&self, coordinate: usize, q: f64) -> f64 {
-        let mut v: Vec<(f64, f64)> = self
+        let pairs = self
             .samples
             .iter()
             .map(|s| s[coordinate])
             .zip(self.weights.iter().copied())
             .collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut acc = 0.0;
-        for (x, w) in &v {
-            acc += w;
-            if acc >= q {
-                return *x;
-            }
-        }
-        v.last().map_or(f64::NAN, |x| x.0)
+        crate::special::weighted_quantile(pairs, q)
     }
     /// Kish effective sample size 1 / sum w^2.
     pub fn effective_sample_size(&self) -> f64 {

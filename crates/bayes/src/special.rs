@@ -36,6 +36,22 @@ pub fn normalized_weights(ln_w: &[f64]) -> Vec<f64> {
     w.iter().map(|x| x / total).collect()
 }
 
+/// The weighted `q` quantile of `(value, weight)` pairs: the smallest value whose cumulative
+/// weight reaches q times the total, inf{x : F(x) >= q} of the weighted empirical distribution
+/// (no interpolation); NaN for no pairs.
+pub fn weighted_quantile(mut values: Vec<(f64, f64)>, q: f64) -> f64 {
+    values.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let target = q * values.iter().map(|v| v.1).sum::<f64>();
+    let mut acc = 0.0;
+    for (x, w) in &values {
+        acc += w;
+        if acc >= target {
+            return *x;
+        }
+    }
+    values.last().map_or(f64::NAN, |x| x.0)
+}
+
 /// The standard normal distribution function Phi(x) = erfc(-x / sqrt 2) / 2 (relative error
 /// < 1.2e-7, from [`erfc`]).
 pub fn normal_cdf(x: f64) -> f64 {

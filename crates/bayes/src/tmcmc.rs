@@ -189,8 +189,14 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
     let evaluations = std::sync::atomic::AtomicUsize::new(n);
     let mut ln_l: Vec<f64> = theta
         .par_iter()
-        .map(|t| counted_ln_likelihood(likelihood, t, &failures))
+        .map(|t| {
+            if observer.cancelled() {
+                return f64::NEG_INFINITY;
+            }
+            counted_ln_likelihood(likelihood, t, &failures)
+        })
         .collect();
+    chatter_progress::check(observer)?;
     if ln_l.iter().all(|l| !l.is_finite()) {
         return Err(BayesError::ZeroLikelihood);
     }
@@ -258,12 +264,14 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
             stage,
             evaluations: &evaluations,
             failures: &failures,
+            observer,
         };
         let moved: Vec<(Vec<f64>, f64, usize)> = idx
             .par_iter()
             .enumerate()
             .map(|(chain, &start)| chains.run(chain, theta[start].clone(), ln_l[start]))
             .collect();
+        chatter_progress::check(observer)?;
         let acc = moved.iter().map(|m| m.2).sum::<usize>() as f64 / (n * steps) as f64;
         theta = moved.iter().map(|m| m.0.clone()).collect();
         ln_l = moved.iter().map(|m| m.1).collect();
@@ -324,17 +332,23 @@ struct Chains<'a, P, L> {
     stage: usize,
     evaluations: &'a std::sync::atomic::AtomicUsize,
     failures: &'a std::sync::atomic::AtomicUsize,
+    /// Polled before every move: a cancelled stage stops its chains where they are.
+    observer: &'a dyn Observer,
 }
 
 impl<P: Prior, L: LogLikelihood> Chains<'_, P, L> {
     /// `steps` moves of chain `chain` from `x` (log-likelihood `lx`): the end point, its
-    /// log-likelihood and the number of accepted moves.
+    /// log-likelihood and the number of accepted moves; fewer moves when the observer asks to
+    /// stop (the caller then discards the stage).
     fn run(&self, chain: usize, mut x: Vec<f64>, mut lx: f64) -> (Vec<f64>, f64, usize) {
         let d = x.len();
         let mut rng = stream(self.seed, self.stage, chain);
         let mut px = self.prior.ln_pdf(&x);
         let mut accepted = 0;
         for _ in 0..self.steps {
+            if self.observer.cancelled() {
+                break;
+            }
             let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
             let step = self.factor * z * self.scale;
             let y: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
@@ -395,6 +409,7 @@ pub fn rejuvenate<P: Prior, L: LogLikelihood>(
             stage: run.betas.len() + round,
             evaluations: &evaluations,
             failures: &failures,
+            observer: &chatter_progress::Silent,
         };
         let moved: Vec<(Vec<f64>, f64, usize)> = theta
             .par_iter()

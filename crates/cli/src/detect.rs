@@ -35,7 +35,7 @@ use crate::output::emit;
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::{Cut, CutEvidence, ModalModel, Observations, Operation, SignalRecord};
 use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
-use chatter_oma::interference::{Interference, LOW_HARMONICS};
+use chatter_oma::interference::Interference;
 use plotters::prelude::*;
 use std::path::PathBuf;
 
@@ -104,9 +104,9 @@ pub fn run(args: &DetectArgs) -> Result<()> {
                 record.file.display()
             )
         };
-        let signals = crate::inputs::signal_record(i, record).with_context(context)?;
+        let signals = chatter_jobs::oma::read_record(i, record).with_context(context)?;
         if let Some(m) = &model {
-            crate::validate::channels_match(m, &signals.names, &context())?;
+            chatter_jobs::oma::channels_match(m, &signals.names, &context())?;
         }
         let mut options = if args.estimate_speed {
             DetectionOptions::unknown_speed()
@@ -158,29 +158,6 @@ pub(crate) fn interference(values: &[String]) -> Result<Interference> {
         .map(Interference::Known)
 }
 
-/// What interference was left out, for a note: the comb found, the fundamentals given, or
-/// nothing.
-pub(crate) fn interference_note(interference: &Interference, d: &Detection) -> String {
-    match (interference, &d.evidence.interference) {
-        (_, Some(c)) => format!(
-            "; interference comb found and left out: {:.3} Hz, {} lines ({} of the first {} \
-             multiples) up to {:.0} Hz",
-            c.fundamental_hz,
-            c.lines_hz.len(),
-            c.low_members,
-            LOW_HARMONICS,
-            c.lines_hz.last().copied().unwrap_or(0.0)
-        ),
-        (Interference::Search { min_hz, max_hz }, None) => {
-            format!("; no interference comb found in {min_hz}-{max_hz} Hz")
-        }
-        (Interference::Known(bases), None) => {
-            format!("; interference given: multiples of {bases:?} Hz left out")
-        }
-        (Interference::Off, None) => String::new(),
-    }
-}
-
 fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estimated: bool) -> Cut {
     let e = &d.evidence;
     // the line that decided: the whole record's, the windows' or the flip line's when only
@@ -224,7 +201,7 @@ fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estima
         radial_immersion: record.radial_immersion,
         note: Some(format!(
             "detect {name}{speed_note}{}{}{}",
-            interference_note(interference, d),
+            chatter_jobs::oma::interference_note(interference, d),
             windows_note(d),
             flip_note(d)
         )),

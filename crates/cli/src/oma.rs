@@ -28,13 +28,12 @@
 
 use crate::output::emit;
 use crate::plot::{ErrorBarPanel, Series, error_bar_panels, line_chart};
-use anyhow::{Context, Result, bail};
-use chatter_dynamics::{ModalModel, Observations, Operation, PoleObservation, SignalRecord};
-use chatter_oma::detection::{DetectionOptions, Verdict, detect};
+use anyhow::{Context, Result};
+use chatter_dynamics::SignalRecord;
+use chatter_jobs::oma::{OmaRequest, RecordAnalysis, identify_observations};
+use chatter_oma::Harmonics;
 use chatter_oma::lifting::lift_at_period;
-use chatter_oma::signals::Signals;
 use chatter_oma::spectrum::first_singular_value;
-use chatter_oma::{Decimation, Harmonics, Identification, IdentifyOptions, Lifting, identify};
 use plotters::style::{BLUE, RGBColor};
 use std::path::{Path, PathBuf};
 
@@ -103,55 +102,44 @@ pub fn run(args: &OmaArgs) -> Result<()> {
     if let (Some(m), Some(path)) = (&model, &args.model) {
         crate::validate::observations_match(m, &observations, &args.observations, path)?;
     }
-    if observations.signals.is_empty() {
-        bail!(
-            "{}: no `signals` to identify; expected at least one entry with a `file`",
-            args.observations.display()
-        );
-    }
-    let mut poles = Vec::with_capacity(observations.signals.len());
-    for (i, record) in observations.signals.iter().enumerate() {
-        let context = || {
-            format!(
-                "{}: signals[{i}] ({})",
-                args.observations.display(),
-                record.file.display()
-            )
-        };
-        let analysis = analyse(i, record, model.as_ref(), args).with_context(context)?;
-        if let Some(plot) = &args.plot {
-            let path = plot_path(plot, i, observations.signals.len());
-            draw(&path, record, &analysis).with_context(context)?;
+    let request = OmaRequest {
+        min_order: args.min_order,
+        max_order: args.max_order,
+        segments: args.segments,
+        harmonics: args
+            .harmonics_hz
+            .as_deref()
+            .map(harmonics_override)
+            .transpose()?,
+        decimation: args.decimation,
+        interference: crate::detect::interference(&args.interference_hz)?,
+        allow_chatter: args.allow_chatter,
+    };
+    let (result, analyses) = identify_observations(&observations, model.as_ref(), &request)
+        .with_context(|| args.observations.display().to_string())?;
+    if let Some(plot) = &args.plot {
+        let count = observations.signals.len();
+        for (i, (record, analysis)) in observations.signals.iter().zip(&analyses).enumerate() {
+            let context = || {
+                format!(
+                    "{}: signals[{i}] ({})",
+                    args.observations.display(),
+                    record.file.display()
+                )
+            };
+            let path = plot_path(plot, i, count);
+            draw(&path, record, analysis).with_context(context)?;
             eprintln!("wrote {}", path.display());
             let orders = path.with_file_name(format!(
                 "{}-orders.svg",
                 path.file_stem()
                     .map_or_else(|| "oma".into(), |s| s.to_string_lossy())
             ));
-            draw_orders(&orders, record, &analysis).with_context(context)?;
+            draw_orders(&orders, record, analysis).with_context(context)?;
             eprintln!("wrote {}", orders.display());
         }
-        poles.push(pole_observation(record, &analysis));
     }
-    let result = Observations {
-        cuts: observations.cuts,
-        poles,
-        signals: Vec::new(),
-    };
     emit(args.out.as_deref(), &result.to_json_string())
-}
-
-/// One identified record.
-struct Analysis {
-    id: Identification,
-    /// Analysed channels (tachometer removed).
-    signals: Signals,
-    lifting: Option<Lifting>,
-    method: String,
-    /// The chatter verdict, when `--allow-chatter` let a chattering record through.
-    chatter_hz: Option<f64>,
-    /// The interference left out by the chatter check (`detect::interference_note`).
-    interference: String,
 }
 
 /// The `--harmonics-hz` override: `none` or frequencies.
@@ -168,142 +156,6 @@ fn harmonics_override(values: &[String]) -> Result<Harmonics> {
         })
         .collect::<Result<Vec<f64>>>()
         .map(Harmonics::Known)
-}
-
-fn analyse(
-    i: usize,
-    record: &SignalRecord,
-    model: Option<&ModalModel>,
-    args: &OmaArgs,
-) -> Result<Analysis> {
-    let mut signals = crate::inputs::signal_record(i, record)?;
-    if let Some(m) = model {
-        crate::validate::channels_match(m, &signals.names, &format!("signals[{i}]"))?;
-    }
-    let mut revolution_s = 60.0 / record.speed_rpm;
-    if let Some(name) = &record.once_per_rev_channel {
-        let c = signals.channel(name).with_context(|| {
-            format!(
-                "`signals[{i}].once_per_rev_channel` `{name}` is not a channel of the record \
-                 (channels: {})",
-                signals.names.join(", ")
-            )
-        })?;
-        revolution_s = signals.pulse_period_s(c)?;
-        signals = signals.without_channel(c)?;
-    }
-    let mut detection_options = DetectionOptions::new(1.0 / revolution_s);
-    detection_options.interference = crate::detect::interference(&args.interference_hz)?;
-    let detection = detect(&signals, &detection_options)?;
-    let interference =
-        crate::detect::interference_note(&detection_options.interference, &detection);
-    let chatter_hz = match (detection.verdict, args.allow_chatter) {
-        (Verdict::Stable, _) => None,
-        (Verdict::Chatter, false) => bail!(
-            "chatter detection calls this record chatter at {:.2} Hz (line variation V {:.3}, \
-             margin {:+.3}{interference}): a chattering cut is not an OMA record, its dominant \
-             line is a limit cycle, not a structural pole; pass --allow-chatter to identify it \
-             anyway",
-            detection.evidence.peak_hz,
-            detection.evidence.line_variation,
-            detection.evidence.margin
-        ),
-        (Verdict::Chatter, true) => Some(detection.evidence.peak_hz),
-    };
-    let teeth = match model.map(ModalModel::operation) {
-        Some(Operation::Milling(m)) => Some(m.teeth()),
-        _ => None,
-    };
-    let mut options = match teeth {
-        Some(teeth) => IdentifyOptions::lifted(revolution_s / teeth as f64, teeth),
-        None => IdentifyOptions::spindle(1.0 / revolution_s),
-    };
-    let lifting = options.lifting;
-    let method = match lifting {
-        Some(l) => format!(
-            "lifted at the tooth period {:.6} s, polyreference",
-            l.period_s
-        ),
-        None => "modified LSCE".to_string(),
-    };
-    if let Some(n) = args.min_order {
-        options.min_order = n;
-    }
-    if let Some(n) = args.max_order {
-        options.max_order = n;
-    }
-    if let Some(n) = args.segments {
-        options.segments = n;
-    }
-    if let Some(values) = &args.harmonics_hz {
-        options.harmonics = harmonics_override(values)?;
-    }
-    if let Some(n) = args.decimation {
-        options.decimation = Decimation::Factor(n);
-    }
-    let id = identify(&signals, &options)?;
-    Ok(Analysis {
-        id,
-        signals,
-        lifting,
-        method,
-        chatter_hz,
-        interference,
-    })
-}
-
-fn pole_observation(record: &SignalRecord, a: &Analysis) -> PoleObservation {
-    let e = &a.id.estimate;
-    let frequency_hz = if a.lifting.is_some() {
-        e.principal_frequency_hz
-    } else {
-        e.frequency_hz
-    };
-    let harmonics = if a.id.harmonics_hz.is_empty() {
-        String::new()
-    } else {
-        format!(", harmonics {:.1?} Hz imposed", a.id.harmonics_hz)
-    };
-    let decimation = if a.id.decimation_factor > 1 {
-        format!(", decimated by {}", a.id.decimation_factor)
-    } else {
-        String::new()
-    };
-    let rejected = if a.id.rejected.is_empty() {
-        String::new()
-    } else {
-        let list: Vec<String> =
-            a.id.rejected
-                .iter()
-                .map(|r| format!("{:.1} Hz ({:?})", r.frequency_hz, r.reason))
-                .collect();
-        format!(", rejected {}", list.join(", "))
-    };
-    let flag = a.chatter_hz.map_or_else(String::new, |f| {
-        format!("; FLAGGED: chatter detection calls the record chatter at {f:.2} Hz")
-    });
-    PoleObservation {
-        speed_rpm: record.speed_rpm,
-        depth_mm: record.depth_mm,
-        frequency_hz,
-        damping_ratio: e.damping_ratio,
-        frequency_std_hz: e.frequency_std_hz,
-        damping_std: e.damping_std,
-        repetitions: u32::try_from(e.repetitions).ok(),
-        sequence: record.sequence,
-        radial_immersion: record.radial_immersion,
-        note: Some(format!(
-            "OMA of {}: {}{decimation}, order {}, {} lags{harmonics}{rejected}{flag}{}",
-            record.file.file_name().map_or_else(
-                || record.file.display().to_string(),
-                |n| n.to_string_lossy().into()
-            ),
-            a.method,
-            a.id.order,
-            a.id.segment_lags,
-            a.interference
-        )),
-    }
 }
 
 /// `plot` itself for a single signal, else `stem-N.ext` for signal N (from 1).
@@ -323,7 +175,7 @@ fn plot_path(plot: &Path, i: usize, count: usize) -> PathBuf {
 /// The stabilization diagram (poles by model order; stable ones in black) over the first
 /// singular value of the PSD matrix of the analysed data (the lifted channels for milling), on a
 /// log scale mapped onto the order axis.
-fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
+fn draw(path: &Path, record: &SignalRecord, a: &RecordAnalysis) -> Result<()> {
     let (data, rate_hz) = match a.lifting {
         Some(l) => {
             let mut lifted = Vec::new();
@@ -340,7 +192,13 @@ fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
     let len = data.first().map_or(0, Vec::len);
     let segment = (len / 8).clamp(4, 4096);
     let psd = first_singular_value(&data, rate_hz, segment)?;
-    let orders: Vec<usize> = a.id.diagram.orders.iter().map(|o| o.order).collect();
+    let orders: Vec<usize> = a
+        .identification
+        .diagram
+        .orders
+        .iter()
+        .map(|o| o.order)
+        .collect();
     let (lo, hi) = (
         orders.iter().copied().min().unwrap_or(1) as f64,
         orders.iter().copied().max().unwrap_or(1) as f64,
@@ -372,7 +230,7 @@ fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
         }
     };
     let (mut stable, mut other) = (Vec::new(), Vec::new());
-    for o in &a.id.diagram.orders {
+    for o in &a.identification.diagram.orders {
         for d in &o.poles {
             let point = (frequency(&d.pole), o.order as f64);
             if d.is_stable() {
@@ -382,7 +240,7 @@ fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
             }
         }
     }
-    let e = &a.id.estimate;
+    let e = &a.identification.estimate;
     let series = [
         Series {
             label: "first singular value of the PSD (log, scaled to the orders)".into(),
@@ -429,13 +287,14 @@ fn draw(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
 
 /// 000 Fig. 3b/c: the mean and standard deviation over the segments of the pole's frequency
 /// and damping ratio at every model order of the diagram; the order used is in the title.
-fn draw_orders(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
+fn draw_orders(path: &Path, record: &SignalRecord, a: &RecordAnalysis) -> Result<()> {
     let lifted = a.lifting.is_some();
-    let stats: Vec<(f64, chatter_oma::identify::PoleEstimate)> =
-        a.id.order_statistics
-            .iter()
-            .filter_map(|s| s.estimate.map(|e| (s.order as f64, e)))
-            .collect();
+    let stats: Vec<(f64, chatter_oma::identify::PoleEstimate)> = a
+        .identification
+        .order_statistics
+        .iter()
+        .filter_map(|s| s.estimate.map(|e| (s.order as f64, e)))
+        .collect();
     let frequency = |e: &chatter_oma::identify::PoleEstimate| {
         if lifted {
             e.principal_frequency_hz
@@ -469,8 +328,8 @@ fn draw_orders(path: &Path, record: &SignalRecord, a: &Analysis) -> Result<()> {
             "{} rpm, {} mm: pole over {} segments by model order (order used: {})",
             record.speed_rpm,
             record.depth_mm,
-            a.id.segment_poles.len(),
-            a.id.order
+            a.identification.segment_poles.len(),
+            a.identification.order
         ),
         "model order",
         &panels,

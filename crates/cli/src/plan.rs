@@ -7,7 +7,8 @@ use chatter_jobs::plan::PlanRequest;
 
 use chatter_updating::joint_prior::PriorFile;
 use chatter_updating::parameters::parse_model_parameters;
-use chatter_updating::plan::{SampledBoundaries, Strategy};
+use chatter_updating::plan::Strategy;
+use chatter_updating::sampled::SampledBoundaries;
 use chatter_updating::update::PriorOverrides;
 use std::path::PathBuf;
 
@@ -95,19 +96,18 @@ pub struct PlanArgs {
 /// `--map-out`: P_s on the sampled speeds x `depths_mm` (or a default grid).
 fn map_csv(b: &SampledBoundaries, depths_mm: Option<&[f64]>) -> String {
     let deepest_mm = b
-        .depths_m
+        .limits_mm
         .iter()
         .flatten()
         .filter(|d| d.is_finite())
-        .fold(0.0f64, |a, d| a.max(d * 1e3));
+        .fold(0.0f64, |a, d| a.max(*d));
     let default: Vec<f64> = (1..=60)
         .map(|i| 1.2 * deepest_mm.max(1e-3) * i as f64 / 60.0)
         .collect();
-    let depths = depths_mm.unwrap_or(&default);
+    let map = b.stability_map(depths_mm.unwrap_or(&default));
     let mut csv = String::from("speed_rpm,depth_mm,p_stable\n");
-    for (k, s) in b.speeds_rpm.iter().enumerate() {
-        for d in depths {
-            let p = b.probability_of_stability(k, d * 1e-3);
+    for (s, row) in map.speeds_rpm.iter().zip(&map.p_stable) {
+        for (d, p) in map.depths_mm.iter().zip(row) {
             csv += &format!("{s},{d},{p}\n");
         }
     }
@@ -117,10 +117,10 @@ fn map_csv(b: &SampledBoundaries, depths_mm: Option<&[f64]>) -> String {
 /// `--boundaries-out`: every path's limiting depth at every sampled speed.
 fn boundaries_csv(b: &SampledBoundaries) -> String {
     let mut csv = String::from("path,probability,speed_rpm,depth_mm\n");
-    for (i, (p, row)) in b.probabilities.iter().zip(&b.depths_m).enumerate() {
+    for (i, (p, row)) in b.probabilities.iter().zip(&b.limits_mm).enumerate() {
         for (s, d) in b.speeds_rpm.iter().zip(row) {
             let depth = if d.is_finite() {
-                format!("{}", d * 1e3)
+                format!("{d}")
             } else {
                 String::new()
             };
@@ -239,12 +239,9 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     let outcome = chatter_jobs::plan::plan(&model, &observations, &request, &progress)
         .map_err(crate::job_error)?;
     progress.finish();
-    if let Some(t) = outcome.next_cut.filter(|t| t.on_contour == Some(false)) {
-        eprintln!(
-            "warning: the P_s = {} contour at {} rpm lies above the deepest candidate depth; \
-             proposing {} mm there (P_s {:.3}), not a cut on the contour: give deeper --depths",
-            request.p_test, t.speed_rpm, t.depth_mm, t.p_stable
-        );
+    let warnings = chatter_jobs::plan::warnings(&outcome, &request);
+    for w in &warnings {
+        eprintln!("warning: {w}");
     }
     let strategy = match args.strategy {
         StrategyArg::Voi => "voi",
@@ -260,13 +257,14 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     let mut json = serde_json::to_value(&outcome)?;
     if let Some(map) = json.as_object_mut() {
         map.insert("strategy".into(), strategy.into());
+        map.insert("warnings".into(), warnings.clone().into());
     }
     if let Some(path) = &args.report {
         crate::report::jobs::plan(
             &model,
             &observations,
             &outcome,
-            (!voi).then_some(request.p_test),
+            &warnings,
             crate::report::jobs::plan_plot(&observations, &outcome),
         )?
         .write(path)?;

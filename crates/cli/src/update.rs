@@ -196,14 +196,9 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     let outcome = job.run(&progress).map_err(crate::job_error)?;
     progress.0.finish();
     let result = outcome.result;
-    for c in &result.classes {
-        if let Some(n) = c.numerical_failures.filter(|&n| n > 0) {
-            let class = c.alpha.map_or(String::new(), |a| format!(" alpha {a}"));
-            eprintln!(
-                "warning: model class{class}: {n} likelihood evaluations failed numerically \
-                 (rejected and counted; see `numerical_failures` in summary.json)"
-            );
-        }
+    let warnings = chatter_jobs::update::warnings(&result);
+    for w in &warnings {
+        eprintln!("warning: {w}");
     }
     if let Some(s) = &result.surrogate {
         eprintln!(
@@ -219,9 +214,6 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             s.mean_abs_ln_likelihood_error,
             s.max_abs_ln_likelihood_error
         );
-    }
-    for p in &result.prior_bound_pileups {
-        eprintln!("warning: {}", crate::report::jobs::pileup_warning(p));
     }
     if args.netcdf {
         let samples = result.samples.samples();

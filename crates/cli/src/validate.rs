@@ -260,23 +260,6 @@ pub fn posterior_matches(model: &ModalModel, dir: &std::path::Path) -> Result<()
     Ok(())
 }
 
-/// The channels of a signal record are the model's coordinates, not the other operation's (a
-/// turning record has `feed`/`cutting`, a milling one `x`/`y`).
-pub fn channels_match(model: &ModalModel, names: &[String], record: &str) -> Result<()> {
-    let (own, other) = match model.operation() {
-        Operation::Milling(_) => (["x", "y"], ["feed", "cutting"]),
-        Operation::Turning(_) => (["feed", "cutting"], ["x", "y"]),
-    };
-    let kind = kind(model);
-    if let Some(name) = names.iter().find(|n| other.contains(&n.as_str())) {
-        bail!(
-            "{record}: channel `{name}` is a coordinate of the other operation, but the model is \
-             {kind} (coordinates {own:?}); is this record from another machine?"
-        );
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

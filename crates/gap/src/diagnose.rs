@@ -17,7 +17,7 @@ use chatter_bayes::tmcmc::{
     TmcmcOptions, TmcmcResult, Variant as Sampler, class_probabilities, rejuvenate, tmcmc,
 };
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_progress::{Observer, Silent};
+use chatter_progress::Observer;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::monodromy::Discretization;
 use rand::SeedableRng;
@@ -357,7 +357,7 @@ pub(crate) fn log_likelihood(
     }
 }
 
-/// Fit one class to `data` by iTMCMC.
+/// Fit one class to `data` by iTMCMC; `observer` hears of its stages and may cancel it.
 pub(crate) fn fit<'a>(
     class: EffectClass,
     nominal: &'a Nominal,
@@ -365,6 +365,7 @@ pub(crate) fn fit<'a>(
     options: &DiagnoseOptions,
     samples: usize,
     seed: u64,
+    observer: &dyn Observer,
 ) -> Result<Fitted<'a>> {
     let model = ClassModel::new(class, nominal)?;
     let count = FailureCount::default();
@@ -374,13 +375,16 @@ pub(crate) fn fit<'a>(
         ..options.tmcmc(samples, seed)
     };
     let run = match class.strata() {
-        None => tmcmc(&model.prior, &like, &tmcmc_options, &Silent),
+        None => tmcmc(&model.prior, &like, &tmcmc_options, observer),
         Some((coordinate, slices)) => uniform_strata(&model.prior, coordinate, slices)
-            .and_then(|strata| stratified_tmcmc(&strata, &like, &tmcmc_options, &Silent)),
+            .and_then(|strata| stratified_tmcmc(&strata, &like, &tmcmc_options, observer)),
     }
-    .map_err(|source| GapError::Sampler {
-        class: class.name(),
-        source,
+    .map_err(|source| match source {
+        chatter_bayes::BayesError::Cancelled(c) => GapError::Cancelled(c),
+        source => GapError::Sampler {
+            class: class.name(),
+            source,
+        },
     })?;
     let (evaluations, failures) = count.get();
     Ok(Fitted {
@@ -607,6 +611,7 @@ pub fn diagnose(
             &options,
             options.samples,
             class_seed(options.seed, class, 0),
+            observer,
         )?;
         observer.class_done(class.name(), f.run.log_evidence);
         fitted.push(f);

@@ -36,6 +36,9 @@ pub enum GapError {
     /// A model could not be built.
     #[error(transparent)]
     Dynamics(#[from] chatter_dynamics::DynamicsError),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

@@ -221,6 +221,7 @@ pub(crate) fn shrink(
             options,
             options.validation_samples,
             class_seed(options.seed, class, fold + 1),
+            observer,
         )?;
         after.add(
             &posterior_predictions(&fitted, &test),

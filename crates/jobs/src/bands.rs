@@ -8,6 +8,7 @@ use chatter_progress::Observer;
 use chatter_stability::Method;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::prepared::SolverOptions;
 use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
 use chatter_uncertainty::montecarlo::{
     QuantileBand, SampledBoundaries, StabilityMap, sample_boundaries,
@@ -177,7 +178,9 @@ impl MonteCarloBands {
 }
 
 /// `samples` draws of the distribution (seeded), the boundary of each at every speed by the
-/// discretization of `method` (004); `observer` hears of each draw.
+/// prepared discretization of `method` at each draw's automatic resolution, Richardson-
+/// extrapolated and searched from the zero-order limit (004;
+/// `chatter_updating::sampled::sample_boundaries`); `observer` hears of each draw.
 pub fn montecarlo(
     model: &ModalModel,
     distribution: &ParameterDistribution,
@@ -187,14 +190,18 @@ pub fn montecarlo(
     speeds_rpm: &[f64],
     observer: &dyn Observer,
 ) -> Result<MonteCarloBands> {
-    let discretization = discretization(method)?;
+    // FDM or SDM, as the perturbation bands (zero-order is refused the same way)
+    discretization(method)?;
     let thetas = distribution.draws(samples, seed)?;
+    let options = SolverOptions {
+        method,
+        boundary: BoundaryOptions::default(),
+    };
     let sampled = sample_boundaries(
-        &discretization,
         &distribution.parameterization(model)?,
         &thetas,
         speeds_rpm,
-        &BoundaryOptions::default(),
+        &options,
         observer,
     )?;
     let depth = sampled.depth_bands();

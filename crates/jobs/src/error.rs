@@ -36,6 +36,17 @@ pub enum JobError {
     /// Gap diagnosis.
     #[error(transparent)]
     Gap(#[from] chatter_gap::GapError),
+    /// Operational modal analysis and chatter detection.
+    #[error(transparent)]
+    Oma(#[from] chatter_oma::OmaError),
+    /// A signal record of an observations file cannot be used.
+    #[error("{record}: {message}")]
+    Record {
+        /// The record, `signals[i]` with its file where known.
+        record: String,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 /// Result alias of this crate.

@@ -8,6 +8,7 @@
 //! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]).
 //! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
 //! - [`bands`]: lobes, Type B offsets (001), credibility bounds (000), Monte Carlo (004).
+//! - [`oma`]: operational modal analysis of every signal record of an observations file.
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
 //! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
 
@@ -18,6 +19,7 @@ pub mod campaign;
 pub mod diagnose;
 pub mod error;
 pub mod inference_data;
+pub mod oma;
 pub mod plan;
 pub mod update;
 

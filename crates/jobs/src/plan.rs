@@ -126,3 +126,22 @@ pub fn plan(
         observer,
     )?)
 }
+
+/// The warnings of a plan, in the one wording that `chatter plan` prints (after `warning: `),
+/// its report page shows and the Python package returns: a next cut proposed at the deepest
+/// candidate depth because the P_s = `p_test` contour lies above the grid (a clipped grid).
+pub fn warnings(outcome: &PlanOutcome, request: &PlanRequest) -> Vec<String> {
+    outcome
+        .next_cut
+        .iter()
+        .filter(|t| t.on_contour == Some(false))
+        .map(|t| {
+            format!(
+                "the P_s = {} contour at {} rpm lies above the deepest candidate depth (a \
+                 clipped grid): {} mm is proposed there (P_s {:.3}), not a cut on the contour; \
+                 give deeper --depths",
+                request.p_test, t.speed_rpm, t.depth_mm, t.p_stable
+            )
+        })
+        .collect()
+}

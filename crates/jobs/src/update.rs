@@ -123,3 +123,34 @@ impl PreparedUpdate {
         })
     }
 }
+
+/// The warnings of an update, in the one wording that `chatter update` prints (after
+/// `warning: `), its report page shows and the Python package returns: every model class whose
+/// likelihood failed numerically (those evaluations are rejected and counted, never read as a
+/// fit), then every parameter whose posterior piles against a bound of its prior (000 Section
+/// 6.3).
+pub fn warnings(result: &UpdateResult) -> Vec<String> {
+    let failures = result.classes.iter().filter_map(|c| {
+        let n = c.numerical_failures.filter(|&n| n > 0)?;
+        let class = c.alpha.map_or(String::new(), |a| format!(" alpha {a}"));
+        Some(format!(
+            "model class{class}: {n} likelihood evaluations failed numerically (rejected and \
+             counted; `numerical_failures` in summary.json)"
+        ))
+    });
+    let pileups = result.prior_bound_pileups.iter().map(|p| {
+        format!(
+            "{}: {:.0} % of the posterior lies at the {} bound {} of its prior (median {}): the \
+             prior decides this parameter, not the data; widen it with --priors",
+            p.parameter,
+            100.0 * p.share_at_bound,
+            match p.bound {
+                chatter_updating::prior_bounds::Bound::Lower => "lower",
+                chatter_updating::prior_bounds::Bound::Upper => "upper",
+            },
+            p.bound_value,
+            p.posterior_median
+        )
+    });
+    failures.chain(pileups).collect()
+}

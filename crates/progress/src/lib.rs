@@ -7,6 +7,11 @@
 //! (time-domain simulation); neither may depend on the other. Every method has a no-op default
 //! (the observers of argmin), so an observer implements only the events it shows.
 //!
+//! The observer is also the way back: a front end that wants a long call stopped (the Python
+//! bindings on Ctrl-C) answers [`Observer::cancelled`] with true, and the loops that report
+//! progress poll it between their steps ([`check`]) and return their crate's `Cancelled` error,
+//! made from [`Cancelled`].
+//!
 //! ```
 //! use chatter_progress::{Observer, Silent};
 //! use std::sync::atomic::{AtomicUsize, Ordering};
@@ -51,6 +56,36 @@ pub trait Observer: Sync {
 
     /// Model class `name` is fitted, with its log-evidence ln p(D | class).
     fn class_done(&self, _name: &str, _log_evidence: f64) {}
+
+    /// Whether the caller asked the computation to stop. Long loops poll it between their steps
+    /// (speeds, samples, sampler moves) and then return [`Cancelled`]; the work in flight
+    /// finishes first, so a cancelled call returns within about one step. Default: never.
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// A computation stopped because its observer asked ([`Observer::cancelled`]); every crate's
+/// error type has a variant made from it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Cancelled;
+
+impl std::fmt::Display for Cancelled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("cancelled by the caller")
+    }
+}
+
+impl std::error::Error for Cancelled {}
+
+/// `Err(Cancelled)` when `observer` asks to stop: the poll of a loop between its steps,
+/// `check(observer)?`.
+pub fn check(observer: &dyn Observer) -> Result<(), Cancelled> {
+    if observer.cancelled() {
+        Err(Cancelled)
+    } else {
+        Ok(())
+    }
 }
 
 /// The observer that does nothing.

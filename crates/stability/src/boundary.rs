@@ -370,7 +370,8 @@ pub fn lobe_diagram<S: StabilitySolver + ?Sized>(
 }
 
 /// `point` at every speed of `speeds_rpm`, in parallel and in order; `observer` hears of each
-/// speed done.
+/// speed done, and a speed not yet started when it asks to stop is not computed
+/// ([`StabilityError::Cancelled`](crate::StabilityError::Cancelled)).
 pub(crate) fn in_parallel(
     speeds_rpm: &[f64],
     observer: &dyn Observer,
@@ -380,6 +381,7 @@ pub(crate) fn in_parallel(
     speeds_rpm
         .par_iter()
         .map(|&s| {
+            chatter_progress::check(observer)?;
             let p = point(s);
             let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             observer.steps_done(k, speeds_rpm.len());

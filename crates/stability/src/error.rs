@@ -32,6 +32,9 @@ pub enum StabilityError {
     /// The model could not be built or perturbed.
     #[error(transparent)]
     Dynamics(#[from] chatter_dynamics::DynamicsError),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

@@ -14,6 +14,9 @@ pub enum UncertaintyError {
     /// A stability computation failed.
     #[error(transparent)]
     Stability(#[from] chatter_stability::StabilityError),
+    /// A sampled boundary could not be built (`chatter_updating::sampled`).
+    #[error(transparent)]
+    Updating(#[from] chatter_updating::UpdatingError),
 }
 
 /// Result alias of this crate.

@@ -1,12 +1,15 @@
 //! Cutting-coefficient uncertainty enters the Monte Carlo map: a K_t standard deviation alone
 //! widens the band, and with K_t and K_n scaled together the limiting depth is exactly
 //! b_lim(s K_t, s K_n) = b_lim(K_t, K_n) / s (the cutting force is linear in b K_t at a fixed
-//! ratio), so the depth quantiles follow from the K_t quantiles analytically.
+//! ratio), so the depth quantiles follow from the K_t quantiles analytically. The samples'
+//! boundaries come from the prepared zero-order method (exact for turning), the nominal one
+//! from the frequency-domain solver (an independent computation).
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::examples;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::frequency_domain::FrequencyDomain;
+use chatter_stability::prepared::{Method, SolverOptions};
 use chatter_uncertainty::montecarlo::{quantile, sample_boundaries};
 use chatter_uncertainty::parameters::ParameterDistribution;
 use rand::SeedableRng;
@@ -14,6 +17,14 @@ use rand_distr::{Distribution, StandardNormal};
 use std::path::Path;
 
 const SD_KT_N_PER_MM2: f64 = 70.0;
+
+/// The prepared zero-order method with the default boundary search (relative tolerance 1e-4).
+fn zoa() -> SolverOptions {
+    SolverOptions {
+        method: Method::Zoa,
+        boundary: BoundaryOptions::default(),
+    }
+}
 
 #[test]
 fn a_kt_standard_deviation_alone_widens_the_band() {
@@ -30,11 +41,10 @@ fn a_kt_standard_deviation_alone_widens_the_band() {
     let speeds = [6900.0, 7300.0];
     let thetas = dist.draws(100, 3).unwrap();
     let sampled = sample_boundaries(
-        &FrequencyDomain,
         &dist.parameterization(&model).unwrap(),
         &thetas,
         &speeds,
-        &BoundaryOptions::default(),
+        &zoa(),
         &chatter_progress::Silent,
     )
     .unwrap();
@@ -75,11 +85,10 @@ fn depth_quantiles_follow_the_kt_quantiles_at_a_fixed_ratio() {
     let speeds = [6900.0, 7300.0];
     let options = BoundaryOptions::default();
     let sampled = sample_boundaries(
-        &FrequencyDomain,
         &dist.parameterization(&model).unwrap(),
         &dist.draws(201, 0).unwrap(),
         &speeds,
-        &options,
+        &zoa(),
         &chatter_progress::Silent,
     )
     .unwrap();
@@ -88,7 +97,7 @@ fn depth_quantiles_follow_the_kt_quantiles_at_a_fixed_ratio() {
             .unwrap()
             .depth_mm();
         // the 5 % depth quantile is b0 over the 95 % K_t quantile (201 samples: both are
-        // order statistics, no interpolation); the boundary search's relative tolerance is
+        // order statistics, no interpolation); the boundary searches' relative tolerances are
         // 1e-4, so 1e-3
         for (q, got) in [(0.05, band.q05), (0.5, band.q50), (0.95, band.q95)] {
             let expected = b0 / quantile(s.clone(), 1.0 - q);

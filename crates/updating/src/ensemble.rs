@@ -28,6 +28,7 @@ use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
 use crate::joint_prior::{SampledPrior, WhitenedLikelihood, WhitenedPrior};
 use crate::parameters::Parameterization;
+use crate::sampled::{SampledBoundaries, boundary_of};
 use chatter_bayes::Prior;
 use chatter_bayes::samples::SampleSet;
 use chatter_bayes::special::normalized_weights;
@@ -273,11 +274,12 @@ impl BoundaryEnsemble {
             .models
             .par_iter()
             .map(|m| {
-                let row = self
-                    .options
-                    .prepare_on_grid_of(m, grid)
-                    .and_then(|solver| solver.limiting_depths(&new))
-                    .map_err(UpdatingError::from);
+                // a failed path is an error here: the paths' probabilities and the value of
+                // information are defined over every path
+                let row = chatter_progress::check(observer)
+                    .map_err(UpdatingError::from)
+                    .and_then(|()| boundary_of(&self.options, m, Some(grid), &new))
+                    .and_then(|points| points.into_iter().collect::<Result<Vec<_>>>());
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 observer.steps_done(k, total);
                 row
@@ -332,13 +334,21 @@ impl BoundaryEnsemble {
         self.columns.iter().map(|c| c.speed_rpm).collect()
     }
 
-    /// Every path's limiting depth (m) at the grid's speeds ([`Self::speeds_rpm`]): one row per
-    /// path, in the order of [`Self::probabilities`]; infinite where the path has no boundary
-    /// below the depth ceiling.
-    pub fn path_depths_m(&self) -> Vec<Vec<f64>> {
-        (0..self.samples.len())
-            .map(|i| self.columns.iter().map(|c| c.points[i].depth_m).collect())
-            .collect()
+    /// The paths' boundaries at the grid's speeds ([`Self::speeds_rpm`]) with their current
+    /// probabilities ([`Self::probabilities`]), as [`SampledBoundaries`] (limits in mm, infinite
+    /// where the path has no boundary below the depth ceiling).
+    pub fn boundaries(&self) -> Result<SampledBoundaries> {
+        let rows = |f: fn(&LobePoint) -> f64| -> Vec<Vec<f64>> {
+            (0..self.samples.len())
+                .map(|i| self.columns.iter().map(|c| f(&c.points[i])).collect())
+                .collect()
+        };
+        SampledBoundaries::new(
+            self.speeds_rpm(),
+            rows(LobePoint::depth_mm),
+            rows(|p| p.chatter_hz),
+        )?
+        .with_probabilities(self.probabilities())
     }
 
     /// Path probabilities P_i (sum 1).
@@ -595,7 +605,7 @@ fn stable_probability(p: &[f64], column: &Column, depth_m: f64) -> f64 {
 
 /// The probability of the paths (probabilities `p`) whose limiting depth `limits_m` lies above
 /// `depth_m`: P_s of 003 Eq. 7 / 004 Eq. 8.
-pub(crate) fn stable_share(p: &[f64], limits_m: impl Iterator<Item = f64>, depth_m: f64) -> f64 {
+fn stable_share(p: &[f64], limits_m: impl Iterator<Item = f64>, depth_m: f64) -> f64 {
     p.iter()
         .zip(limits_m)
         .filter(|(_, limit)| depth_m < *limit)

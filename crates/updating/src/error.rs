@@ -23,6 +23,9 @@ pub enum UpdatingError {
     /// A stability computation failed.
     #[error(transparent)]
     Stability(#[from] chatter_stability::StabilityError),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

@@ -9,6 +9,7 @@
 //! | [`milling`] | identified Floquet multipliers (frequency, damping) against the exact discretized monodromy operator, sigma_zeta = alpha sigma_w | 002 Eq. 13-15 |
 //! | [`cuts`] | stable / chatter results with chatter frequency; the one-sided kernel | 004 Eq. 5, 003 Eq. 3-4 |
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
+//! | [`sampled`] | sampled stability boundaries (limits and chatter frequencies per sample and speed, probabilities, failures), P_s maps and quantile bands | 003 Eq. 7, 004 Eq. 8, Fig. 2 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
 //! | [`schmitz2022`] | 004's example with its correlated RCSA prior: the paper's numbers beside ours | 004 Sec. 2, 3, 6 |
 //! | [`karandikar`] | 003's prior, Table 2's candidate tests with the paper's numbers, RSS identification of C | 003 |
@@ -51,6 +52,7 @@ pub mod milling;
 pub mod parameters;
 pub mod plan;
 pub mod prior_bounds;
+pub mod sampled;
 pub mod schmitz2022;
 pub mod surrogate;
 pub mod turning;

@@ -9,6 +9,7 @@ use crate::ensemble::{BoundaryEnsemble, TestPlan, material_removal_rate_cm3_per_
 use crate::error::{Result, UpdatingError};
 use crate::joint_prior::{JointNormal, SampledPrior};
 use crate::parameters::{ModelParameter, Parameterization};
+use crate::sampled::SampledBoundaries;
 use crate::update::PriorOverrides;
 use chatter_bayes::prior::Marginal;
 use chatter_dynamics::{ModalModel, Observations};
@@ -118,29 +119,6 @@ pub struct PlanOutcome {
     /// --boundaries-out`; not in the JSON).
     #[serde(skip)]
     pub boundaries: SampledBoundaries,
-}
-
-/// The weighted sampled stability boundaries of a plan: P_s(speed, depth) is the probability of
-/// the paths whose limiting depth at that speed lies above the depth (003 Eq. 7, 004 Eq. 8).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SampledBoundaries {
-    /// The speeds of the grid (rpm).
-    pub speeds_rpm: Vec<f64>,
-    /// Path probabilities (sum 1).
-    pub probabilities: Vec<f64>,
-    /// Each path's limiting depth (m) at every speed (infinite: no boundary below the ceiling).
-    pub depths_m: Vec<Vec<f64>>,
-}
-
-impl SampledBoundaries {
-    /// P_s at speed index `k` and depth `depth_m`.
-    pub fn probability_of_stability(&self, k: usize, depth_m: f64) -> f64 {
-        crate::ensemble::stable_share(
-            &self.probabilities,
-            self.depths_m.iter().map(|d| d[k]),
-            depth_m,
-        )
-    }
 }
 
 /// Candidate speeds and depths when the settings give none. With cuts: the cut speeds +- 25 %
@@ -352,11 +330,7 @@ pub fn plan_next_cut(
         posterior_sd: moments.iter().map(|m| m.1).collect(),
         best_stable_mrr_cm3_per_min: best_stable,
         effective_samples: ensemble.effective_sample_size(),
-        boundaries: SampledBoundaries {
-            speeds_rpm: ensemble.speeds_rpm(),
-            probabilities: ensemble.probabilities(),
-            depths_m: ensemble.path_depths_m(),
-        },
+        boundaries: ensemble.boundaries()?,
     })
 }
 

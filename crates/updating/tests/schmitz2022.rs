@@ -59,19 +59,19 @@ fn proposed_cut_is_on_the_contour_of_the_exported_boundaries_and_the_cap_stops()
     let p: f64 = b
         .probabilities
         .iter()
-        .zip(&b.depths_m)
-        .filter(|(_, d)| d[k] > cut.depth_mm * 1e-3)
+        .zip(&b.limits_mm)
+        .filter(|(_, d)| d[k] > cut.depth_mm)
         .map(|(w, _)| w)
         .sum();
     assert!((p - cut.p_stable).abs() < 1e-12, "{p} {}", cut.p_stable);
     assert!((cut.p_stable - 0.5).abs() <= 0.05, "{cut:?}");
     assert_eq!(cut.on_contour, Some(true));
     // a deeper grid point at that speed would fall below P_test: the cut is the contour's
-    let deeper = cut.depth_mm * 1e-3 + 0.1e-3;
+    let deeper = cut.depth_mm + 0.1;
     let p_deeper: f64 = b
         .probabilities
         .iter()
-        .zip(&b.depths_m)
+        .zip(&b.limits_mm)
         .filter(|(_, d)| d[k] > deeper)
         .map(|(w, _)| w)
         .sum();

@@ -6,7 +6,9 @@ same inputs and seed give bit-identical results. Units are in every name: ``spee
 ``depth_mm``, ``frequency_hz``; log-evidences and log-likelihoods are in nats.
 
 Models and observations are given as a path (JSON, or a cuts CSV for observations) or as a
-dict in the file format of the README. Long calls release the GIL and stop on Ctrl-C.
+dict in the file format of the README. Long calls release the GIL and stop on Ctrl-C: the
+libraries are cancelled inside (between speeds, samples and sampler moves) before
+``KeyboardInterrupt`` is raised.
 """
 
 from ._chatter import (  # noqa: F401
@@ -23,6 +25,7 @@ from ._chatter import (  # noqa: F401
     lobes,
     multiplier,
     oma,
+    oma_observations,
     plan,
     read_manifest,
     run_campaign,

@@ -103,6 +103,25 @@ def oma(
     """Dominant pole of a stable record (modified LSCE with the spindle harmonics):
     ``frequency_hz``, ``frequency_std_hz``, ``damping_ratio``, ``damping_std``, ``repetitions``."""
 
+def oma_observations(
+    observations: Source,
+    model: Optional[Source] = None,
+    min_order: Optional[int] = None,
+    max_order: Optional[int] = None,
+    segments: Optional[int] = None,
+    harmonics_hz: Optional[Sequence[float]] = None,
+    decimation: Optional[int] = None,
+    interference_hz: Optional[Sequence[float]] = None,
+    allow_chatter: bool = False,
+) -> dict:
+    """OMA of every signal record of an observations file or dict (the ``chatter oma
+    --observations FILE`` job): ``observations`` (the command's JSON, the input's cuts with one
+    pole per record) and arrays over the records ``speed_rpm``, ``frequency_hz`` (Hz),
+    ``damping_ratio``, ``frequency_std_hz``, ``damping_std``. A chattering record is refused
+    (``ValueError``) unless ``allow_chatter``; a milling ``model`` makes the identification
+    lifted at the tooth period. ``harmonics_hz``: None for the spindle lines, [] for none;
+    ``interference_hz``: None to search a mains comb, [] for none."""
+
 def update(
     model: Source,
     observations: Source,
@@ -120,7 +139,8 @@ def update(
     (draws x parameters), ``weights``, ``posterior_mean``, ``posterior_covariance``,
     ``classes`` (``alpha``, ``log_evidence`` and ``data_fit`` in nats, ``probability``),
     ``selected_alpha``, ``prior_draws``, ``log_likelihood`` (draws x observations, nats),
-    ``updated_model``, ``pole_table``, ``prior_bound_pileups``, ``surrogate``."""
+    ``updated_model``, ``pole_table``, ``prior_bound_pileups``, ``surrogate``, ``warnings`` (the
+    sentences ``chatter update`` prints after ``warning:``)."""
 
 def plan(
     model: Source,
@@ -138,7 +158,8 @@ def plan(
     max_tests: int = 10,
 ) -> dict:
     """The next test cut (the ``chatter plan`` JSON): ``next_cut`` (``speed_rpm``, ``depth_mm``,
-    ``p_stable``, ...), ``stop``, ``posterior_mean``, ``posterior_sd``, ..."""
+    ``p_stable``, ...), ``stop``, ``posterior_mean``, ``posterior_sd``, ..., ``warnings`` (the
+    sentences ``chatter plan`` prints after ``warning:``)."""
 
 def diagnose(
     model: Source,

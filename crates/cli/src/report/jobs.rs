@@ -36,22 +36,6 @@ fn common(title: &str, model: &ModalModel, observations: Option<&Observations>) 
     page
 }
 
-/// The warning of a parameter whose posterior piles against a bound of its prior.
-pub fn pileup_warning(p: &chatter_updating::prior_bounds::BoundPileup) -> String {
-    format!(
-        "{}: {:.0} % of the posterior lies at the {} bound {} of its prior (median {}): the \
-         prior decides this parameter, not the data; widen it with --priors",
-        p.parameter,
-        100.0 * p.share_at_bound,
-        match p.bound {
-            chatter_updating::prior_bounds::Bound::Lower => "lower",
-            chatter_updating::prior_bounds::Bound::Upper => "upper",
-        },
-        number(p.bound_value),
-        number(p.posterior_median)
-    )
-}
-
 /// Posterior mean and standard deviation per parameter, with units.
 fn posterior_table(caption: &str, names: &[String], mean: &[f64], sd: &[f64]) -> Table {
     let mut t = Table::new(
@@ -103,19 +87,8 @@ pub fn update(
         "Next: chatter bands --kind perturbation (or montecarlo) --posterior with this output \
          folder draws the updated lobes with their credibility bounds.",
     );
-    for p in &r.prior_bound_pileups {
-        page.warning(pileup_warning(p));
-    }
-    for c in &r.classes {
-        if let Some(n) = c.numerical_failures.filter(|&n| n > 0) {
-            let class = c
-                .alpha
-                .map_or(String::new(), |a| format!(" alpha {}", number(a)));
-            page.warning(format!(
-                "model class{class}: {n} likelihood evaluations failed numerically (rejected \
-                 and counted)"
-            ));
-        }
+    for w in chatter_jobs::update::warnings(r) {
+        page.warning(w);
     }
     let n = r.parameter_names.len();
     let sd: Vec<f64> = (0..n)
@@ -717,15 +690,18 @@ pub fn plan_plot(
 }
 
 /// The page of `chatter plan`: `plot` is the cuts with the proposed one (None when nothing
-/// could be drawn, with the reason).
+/// could be drawn, with the reason); `warnings` are the plan's (`chatter_jobs::plan::warnings`).
 pub fn plan(
     model: &ModalModel,
     observations: &Observations,
     outcome: &PlanOutcome,
-    p_test: Option<f64>,
+    warnings: &[String],
     plot: std::result::Result<String, String>,
 ) -> Result<Page> {
     let mut page = common("chatter plan: the next test cut", model, Some(observations));
+    for w in warnings {
+        page.warning(w.clone());
+    }
     if outcome.stop {
         page.verdict(format!(
             "Stop testing: {}.",
@@ -755,16 +731,6 @@ pub fn plan(
             }
             text.push_str(").");
             page.verdict(text);
-            if t.on_contour == Some(false) {
-                page.warning(format!(
-                    "the P_s = {} contour at {} rpm lies above the deepest candidate depth (a \
-                     clipped grid): {} mm is proposed there, not a cut on the contour; give \
-                     deeper --depths",
-                    optional(p_test),
-                    number(t.speed_rpm),
-                    number(t.depth_mm)
-                ));
-            }
         }
         None => {
             page.verdict("No candidate cut qualifies: there is no next test on this grid.");
