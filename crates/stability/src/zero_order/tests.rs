@@ -280,6 +280,33 @@ fn ceilings_and_bad_inputs() {
     );
 }
 
+/// Largest relative difference between the zero-order `table` of `model` at `speeds` and the
+/// measured-FRF route on its receptance sampled every 0.05 Hz from 0.25 to 2 times `f_max_hz`.
+fn worst_against_sampled(
+    model: &ModalModel,
+    table: &[LobePoint],
+    speeds: &[f64],
+    f_max_hz: f64,
+) -> f64 {
+    let (lo, hi) = (0.25 * f_max_hz, 2.0 * f_max_hz);
+    let grid: Vec<f64> = (0..((hi - lo) / 0.05) as usize)
+        .map(|k| lo + 0.05 * k as f64)
+        .collect();
+    let sampled = measured_limiting_depths(
+        model.operation(),
+        model.cutting(),
+        &model.sampled_receptance(grid).unwrap(),
+        speeds,
+        &ZeroOrderOptions::unbounded(),
+    )
+    .unwrap();
+    table
+        .iter()
+        .zip(&sampled)
+        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Non-proportional modes: the zero-order table of a model with complex residues against the
 /// measured-FRF route on its receptance sampled at 0.05 Hz (a different solver: interpolation
 /// and bisection on samples, no modal grid); the methods built on real modal coordinates refuse
@@ -302,23 +329,7 @@ fn complex_modes_in_the_table_agree_with_their_sampled_receptance() {
         .iter()
         .map(|m| m.frequency_hz())
         .fold(0.0, f64::max);
-    let (lo, hi) = (0.25 * f_max, 2.0 * f_max);
-    let grid: Vec<f64> = (0..((hi - lo) / 0.05) as usize)
-        .map(|k| lo + 0.05 * k as f64)
-        .collect();
-    let sampled = measured_limiting_depths(
-        model.operation(),
-        model.cutting(),
-        &model.sampled_receptance(grid).unwrap(),
-        &speeds,
-        &ZeroOrderOptions::unbounded(),
-    )
-    .unwrap();
-    let worst = table
-        .iter()
-        .zip(&sampled)
-        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
-        .fold(0.0, f64::max);
+    let worst = worst_against_sampled(&model, &table, &speeds, f_max);
     assert!(worst < 1e-4, "{worst}");
     // the phases matter: the real-mode lobes differ
     let real = zoa_lobes(&base, &speeds).unwrap();
@@ -375,23 +386,7 @@ fn residual_terms_in_the_table_agree_with_their_sampled_receptance() {
         .unwrap();
     let speeds: Vec<f64> = (0..40).map(|i| 5000.0 + 250.0 * i as f64).collect();
     let table = zoa_lobes(&model, &speeds).unwrap();
-    let (lo, hi) = (0.25 * 750.0, 2.0 * 750.0);
-    let grid: Vec<f64> = (0..((hi - lo) / 0.05) as usize)
-        .map(|k| lo + 0.05 * k as f64)
-        .collect();
-    let sampled = measured_limiting_depths(
-        model.operation(),
-        model.cutting(),
-        &model.sampled_receptance(grid).unwrap(),
-        &speeds,
-        &ZeroOrderOptions::unbounded(),
-    )
-    .unwrap();
-    let worst = table
-        .iter()
-        .zip(&sampled)
-        .map(|(a, b)| (a.depth_m / b.depth_m - 1.0).abs())
-        .fold(0.0, f64::max);
+    let worst = worst_against_sampled(&model, &table, &speeds, 750.0);
     let plain = zoa_lobes(&base, &speeds).unwrap();
     let moved = table
         .iter()
