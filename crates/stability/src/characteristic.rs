@@ -115,8 +115,8 @@ impl Characteristic {
 
     /// Newton step 1 / tr(D^{-1} D') at width `a`; `None` where D' vanishes. With one or two
     /// modes (most models inside samplers) tr(D^{-1} D') = (det D)' / det D in closed form;
-    /// with more, by an LU factorization in place ([`inverse_trace`]); neither allocates up to
-    /// [`STACK_MODES`] modes.
+    /// with more, by an LU factorization with partial pivoting in place, D' eliminated
+    /// alongside and the trace by back substitution; neither allocates up to four modes.
     pub fn newton_step(&self, lambda: Complex64, a: f64) -> Option<Complex64> {
         let n = self.omegas.len();
         let e = (-lambda * self.tau).exp();
