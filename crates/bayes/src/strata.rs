@@ -19,7 +19,7 @@ use crate::error::{BayesError, Result};
 use crate::prior::{IndependentPrior, Marginal, Prior};
 use crate::samples::SampleSet;
 use crate::special::log_sum_exp;
-use crate::tmcmc::{LogLikelihood, TmcmcOptions, TmcmcResult, stream, tmcmc};
+use crate::tmcmc::{LogLikelihood, TmcmcOptions, TmcmcResult, stream, systematic_resample, tmcmc};
 use chatter_progress::Observer;
 
 /// One stratum: the prior restricted to it (normalized) and the stratum's prior mass.
@@ -176,19 +176,10 @@ fn pool<P>(
             );
         }
     }
-    let mut rng = stream(seed, usize::MAX - 2, 0);
-    let u0: f64 = rand::Rng::random::<f64>(&mut rng) / n as f64;
-    let (mut samples, mut ln_likelihoods) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    let (mut c, mut k) = (union[0].2, 0);
-    for i in 0..n {
-        let u = u0 + i as f64 / n as f64;
-        while u > c && k + 1 < union.len() {
-            k += 1;
-            c += union[k].2;
-        }
-        samples.push(union[k].0.clone());
-        ln_likelihoods.push(union[k].1);
-    }
+    let weights: Vec<f64> = union.iter().map(|u| u.2).collect();
+    let idx = systematic_resample(&weights, n, &mut stream(seed, usize::MAX - 2, 0));
+    let samples: Vec<Vec<f64>> = idx.iter().map(|&k| union[k].0.clone()).collect();
+    let ln_likelihoods: Vec<f64> = idx.iter().map(|&k| union[k].1).collect();
     let dominant = (0..runs.len())
         .max_by(|&a, &b| log_terms[a].total_cmp(&log_terms[b]))
         .and_then(|k| runs[k].as_ref())

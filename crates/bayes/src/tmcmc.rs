@@ -229,19 +229,7 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         log_evidence += log_mean_exp(&ln_w);
         let weights = normalized_weights(&ln_w);
         let chol = proposal_factor(&theta, &weights)?;
-        // systematic resampling (deterministic given the weights and one uniform per stage)
-        let mut rng = stream(options.seed, stage, usize::MAX);
-        let u0: f64 = rand::Rng::random::<f64>(&mut rng) / n as f64;
-        let mut idx = Vec::with_capacity(n);
-        let (mut c, mut k) = (weights[0], 0);
-        for i in 0..n {
-            let u = u0 + i as f64 / n as f64;
-            while u > c && k + 1 < n {
-                k += 1;
-                c += weights[k];
-            }
-            idx.push(k);
-        }
+        let idx = systematic_resample(&weights, n, &mut stream(options.seed, stage, usize::MAX));
         let burn = if options.variant == Variant::Improved {
             options.burn_in
         } else {
@@ -297,6 +285,23 @@ pub fn tmcmc<P: Prior, L: LogLikelihood>(
         evaluations: evaluations.into_inner(),
         numerical_failures: failures.into_inner(),
     })
+}
+
+/// Systematic resampling: `n` indices into `weights` (normalized), index k drawn about
+/// n w_k times, deterministic given the weights and one uniform from `rng`.
+pub(crate) fn systematic_resample(weights: &[f64], n: usize, rng: &mut StdRng) -> Vec<usize> {
+    let u0: f64 = rand::Rng::random::<f64>(rng) / n as f64;
+    let mut idx = Vec::with_capacity(n);
+    let (mut c, mut k) = (weights[0], 0);
+    for i in 0..n {
+        let u = u0 + i as f64 / n as f64;
+        while u > c && k + 1 < weights.len() {
+            k += 1;
+            c += weights[k];
+        }
+        idx.push(k);
+    }
+    idx
 }
 
 /// Cholesky factor of the weighted covariance of `theta` (with a relative jitter of 1e-12): the
