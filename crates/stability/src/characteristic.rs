@@ -140,16 +140,10 @@ impl Characteristic {
             }
             _ => {
                 let trace = if n <= STACK_MODES {
-                    let mut d = [zero; STACK_MODES * STACK_MODES];
-                    let mut dd = [zero; STACK_MODES * STACK_MODES];
-                    fill(&mut d[..n * n], n, entry);
-                    fill(&mut dd[..n * n], n, derivative);
-                    inverse_trace(&mut d[..n * n], &mut dd[..n * n], n)
+                    let mut buffer = [zero; 2 * STACK_MODES * STACK_MODES];
+                    filled_inverse_trace(&mut buffer[..2 * n * n], n, entry, derivative)
                 } else {
-                    let (mut d, mut dd) = (vec![zero; n * n], vec![zero; n * n]);
-                    fill(&mut d, n, entry);
-                    fill(&mut dd, n, derivative);
-                    inverse_trace(&mut d, &mut dd, n)
+                    filled_inverse_trace(&mut vec![zero; 2 * n * n], n, entry, derivative)
                 };
                 // an exactly singular D means lambda is already a root: no step
                 let Some(tr) = trace else {
@@ -206,13 +200,22 @@ impl Characteristic {
 /// Modes up to which [`Characteristic::newton_step`] factorizes on the stack.
 const STACK_MODES: usize = 4;
 
-/// `m` (row-major n x n) filled with `f(i, j)`.
-fn fill(m: &mut [Complex64], n: usize, f: impl Fn(usize, usize) -> Complex64) {
-    for (i, row) in m.chunks_exact_mut(n).enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v = f(i, j);
+/// [`inverse_trace`] of D and D' given entry by entry, in `buffer` (2 n^2 entries: D then D',
+/// row-major).
+fn filled_inverse_trace(
+    buffer: &mut [Complex64],
+    n: usize,
+    entry: impl Fn(usize, usize) -> Complex64,
+    derivative: impl Fn(usize, usize) -> Complex64,
+) -> Option<Complex64> {
+    let (d, dd) = buffer.split_at_mut(n * n);
+    for i in 0..n {
+        for j in 0..n {
+            d[i * n + j] = entry(i, j);
+            dd[i * n + j] = derivative(i, j);
         }
     }
+    inverse_trace(d, dd, n)
 }
 
 /// tr(D^{-1} D') for row-major n x n `d` and `dd`, both overwritten: LU of D with partial
