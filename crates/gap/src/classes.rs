@@ -47,6 +47,62 @@ const MODE_GAP: f64 = 0.05;
 /// Largest relative frequency drop at the highest observed speed.
 const MAX_SOFTENING: f64 = 0.2;
 
+/// Where each parameter sits in a class's vector: the recalibration (ln s_f, ln s_zeta, ln g)
+/// first, then the class's own parameters (the table in the module docs).
+mod slot {
+    /// ln s_f, the natural-frequency factor.
+    pub const FREQUENCY_SCALE: usize = 0;
+    /// ln s_zeta, the damping factor.
+    pub const DAMPING_SCALE: usize = 1;
+    /// ln g, the cutting-over-stiffness factor.
+    pub const CUTTING_OVER_STIFFNESS: usize = 2;
+    /// The one parameter of `process_damping` (C / C_max), `speed_dependent_dynamics` (the drop
+    /// at the highest speed) and `drift` (r).
+    pub const EFFECT: usize = 3;
+    /// `extra_mode`: ln(f / f_ref).
+    pub const EXTRA_FREQUENCY: usize = 3;
+    /// `extra_mode`: ln zeta.
+    pub const EXTRA_DAMPING: usize = 4;
+    /// `extra_mode`: ln(k / k_ref).
+    pub const EXTRA_STIFFNESS: usize = 5;
+    /// `extra_mode`: the direction's angle from x (rad, an axis: period pi).
+    pub const EXTRA_DIRECTION: usize = 6;
+}
+
+/// The extra mode of `extra_mode` at parameters theta, in physical units.
+struct ExtraMode {
+    frequency_hz: f64,
+    damping_ratio: f64,
+    stiffness_n_per_m: f64,
+    direction_rad: f64,
+}
+
+impl ExtraMode {
+    fn new(nominal: &Nominal, theta: &[f64]) -> Self {
+        Self {
+            frequency_hz: nominal.reference_hz * theta[slot::EXTRA_FREQUENCY].exp(),
+            damping_ratio: theta[slot::EXTRA_DAMPING].exp(),
+            stiffness_n_per_m: nominal.reference_stiffness_n_per_m
+                * theta[slot::EXTRA_STIFFNESS].exp(),
+            direction_rad: theta[slot::EXTRA_DIRECTION],
+        }
+    }
+
+    /// The mode with a mass-normalized shape of modulus omega / sqrt(k) along its direction.
+    fn mode(&self) -> Option<Mode> {
+        let amplitude = 2.0 * PI * self.frequency_hz / self.stiffness_n_per_m.sqrt();
+        Mode::new(
+            self.frequency_hz,
+            self.damping_ratio,
+            ModeShape::MassNormalized([
+                amplitude * self.direction_rad.cos(),
+                amplitude * self.direction_rad.sin(),
+            ]),
+        )
+        .ok()
+    }
+}
+
 /// A candidate explanation of the gap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -73,7 +129,7 @@ impl EffectClass {
     /// failed and the verdict was `unexplained`).
     pub fn strata(self) -> Option<(usize, usize)> {
         match self {
-            EffectClass::ExtraMode => Some((3, EXTRA_MODE_STRATA)),
+            EffectClass::ExtraMode => Some((slot::EXTRA_FREQUENCY, EXTRA_MODE_STRATA)),
             _ => None,
         }
     }
@@ -305,36 +361,28 @@ impl<'a> ClassModel<'a> {
 
     /// The variant at parameters `theta`; None where they make no physical model.
     pub fn variant(&self, theta: &[f64]) -> Option<Variant> {
-        let (sf, sz, g) = (theta[0].exp(), theta[1].exp(), theta[2].exp());
+        let (sf, sz, g) = (
+            theta[slot::FREQUENCY_SCALE].exp(),
+            theta[slot::DAMPING_SCALE].exp(),
+            theta[slot::CUTTING_OVER_STIFFNESS].exp(),
+        );
         let model = recalibrated(&self.nominal.model, sf, sz, g).ok()?;
         let mut v = Variant::new(model);
         match self.class {
             EffectClass::ParameterError => {}
             EffectClass::ProcessDamping => {
-                let c = theta[3] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0);
+                let c = self.process_damping_n_per_m(theta);
                 v.model = v.model.with_process_damping((c > 0.0).then_some(c)).ok()?;
             }
             EffectClass::SpeedDependentDynamics => {
-                v.softening_per_rpm2 = theta[3] / self.nominal.max_speed_rpm.powi(2);
+                v.softening_per_rpm2 = self.softening_per_rpm2(theta);
             }
             EffectClass::ExtraMode => {
-                let f = self.nominal.reference_hz * theta[3].exp();
-                let k = self.nominal.reference_stiffness_n_per_m * theta[5].exp();
-                let amplitude = 2.0 * PI * f / k.sqrt();
-                let mode = Mode::new(
-                    f,
-                    theta[4].exp(),
-                    ModeShape::MassNormalized([
-                        amplitude * theta[6].cos(),
-                        amplitude * theta[6].sin(),
-                    ]),
-                )
-                .ok()?;
                 let mut modes = v.model.modes().to_vec();
-                modes.push(mode);
+                modes.push(ExtraMode::new(self.nominal, theta).mode()?);
                 v.model = v.model.with_modes(modes).ok()?;
             }
-            EffectClass::Drift => v.drift_rate = theta[3],
+            EffectClass::Drift => v.drift_rate = theta[slot::EFFECT],
         }
         Some(v)
     }
@@ -373,9 +421,10 @@ impl<'a> ClassModel<'a> {
             .collect();
         if self.class == EffectClass::ExtraMode {
             let (s, c) = members.iter().fold((0.0, 0.0), |(s, c), t| {
-                (s + (2.0 * t[6]).sin(), c + (2.0 * t[6]).cos())
+                let doubled = 2.0 * t[slot::EXTRA_DIRECTION];
+                (s + doubled.sin(), c + doubled.cos())
             });
-            mean[6] = (0.5 * s.atan2(c)).rem_euclid(PI);
+            mean[slot::EXTRA_DIRECTION] = (0.5 * s.atan2(c)).rem_euclid(PI);
         }
         Some(mean)
     }
@@ -383,36 +432,42 @@ impl<'a> ClassModel<'a> {
     /// Reported parameters at `theta`: names with units and values.
     pub fn physical(&self, theta: &[f64]) -> Vec<(&'static str, f64)> {
         let mut out = vec![
-            ("frequency_factor", theta[0].exp()),
-            ("damping_factor", theta[1].exp()),
-            ("cutting_over_stiffness_factor", theta[2].exp()),
+            ("frequency_factor", theta[slot::FREQUENCY_SCALE].exp()),
+            ("damping_factor", theta[slot::DAMPING_SCALE].exp()),
+            (
+                "cutting_over_stiffness_factor",
+                theta[slot::CUTTING_OVER_STIFFNESS].exp(),
+            ),
         ];
         match self.class {
             EffectClass::ParameterError => {}
-            EffectClass::ProcessDamping => out.push((
-                "c_n_per_m",
-                theta[3] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0),
-            )),
+            EffectClass::ProcessDamping => {
+                out.push(("c_n_per_m", self.process_damping_n_per_m(theta)))
+            }
             EffectClass::SpeedDependentDynamics => {
-                out.push(("frequency_drop_at_max_speed", theta[3]));
-                out.push((
-                    "softening_per_rpm2",
-                    theta[3] / self.nominal.max_speed_rpm.powi(2),
-                ));
+                out.push(("frequency_drop_at_max_speed", theta[slot::EFFECT]));
+                out.push(("softening_per_rpm2", self.softening_per_rpm2(theta)));
             }
             EffectClass::ExtraMode => {
-                let f = self.nominal.reference_hz * theta[3].exp();
-                out.push(("frequency_hz", f));
-                out.push(("damping_ratio", theta[4].exp()));
-                out.push((
-                    "stiffness_n_per_m",
-                    self.nominal.reference_stiffness_n_per_m * theta[5].exp(),
-                ));
-                out.push(("direction_deg", theta[6].to_degrees()));
+                let extra = ExtraMode::new(self.nominal, theta);
+                out.push(("frequency_hz", extra.frequency_hz));
+                out.push(("damping_ratio", extra.damping_ratio));
+                out.push(("stiffness_n_per_m", extra.stiffness_n_per_m));
+                out.push(("direction_deg", extra.direction_rad.to_degrees()));
             }
-            EffectClass::Drift => out.push(("cutting_change_over_campaign", theta[3])),
+            EffectClass::Drift => out.push(("cutting_change_over_campaign", theta[slot::EFFECT])),
         }
         out
+    }
+
+    /// `process_damping`'s C (N/m) at theta.
+    fn process_damping_n_per_m(&self, theta: &[f64]) -> f64 {
+        theta[slot::EFFECT] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0)
+    }
+
+    /// `speed_dependent_dynamics`'s c in f_n(Omega) = f_n0 (1 - c Omega^2) at theta (1/rpm^2).
+    fn softening_per_rpm2(&self, theta: &[f64]) -> f64 {
+        theta[slot::EFFECT] / self.nominal.max_speed_rpm.powi(2)
     }
 }
 
