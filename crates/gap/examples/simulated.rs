@@ -87,6 +87,13 @@ fn main() -> chatter_gap::Result<()> {
                         );
                     }
                     eprintln!("  nominal check {:?}", d.nominal_check);
+                    for c in &d.classes {
+                        eprintln!(
+                            "  {}: ln Z {:.1}, failures {} of {}",
+                            c.name, c.log_evidence, c.solver_failures, c.evaluations
+                        );
+                    }
+                    eprintln!("  {} check {:?}", d.best_class, d.predictive_check);
                 }
                 let expected = effect.expected_verdict(&error);
                 total += 1;

@@ -53,7 +53,22 @@
 //! ([`generator::proving_machines`]: two-direction milling, low radial immersion, two modes in
 //! one direction, turning). The truth is the semi-discretization at four times the resolution,
 //! itself checked against an RK4 integration and the closed-form single-DOF turning boundary;
-//! `examples/confusion.rs` prints the confusion matrix and the held-out closure.
+//! `examples/confusion.rs` prints the confusion matrix and the held-out closure. Measured with
+//! the sampler of this version (seed 0, 70 campaigns of 24-40 cuts, all five classes):
+//!
+//! | magnitude | xy 30 % | low immersion 7 % | two modes in x | turning | all |
+//! |---|---|---|---|---|---|
+//! | 0.5x | 5/5 | 4/5 | 3/5 | 1/5 | 13/20 (65 %) |
+//! | 1x | 5/5 | 5/5 | 5/5 | 4/5 | 19/20 (95 %) |
+//! | 2x | 5/5 | 5/5 | 4/5 | 4/5 | 18/20 (90 %) |
+//! | control (`consistent`) | 1/1 | 1/1 | 1/1 | 1/1 | 4/4 |
+//! | outside the list (`unexplained`) | 2/2 | 2/2 | 1/1 | 1/1 | 6/6 |
+//!
+//! Median held-out closure 0.88 over the 64 campaigns with a gap. The misses: at 0.5x the effect
+//! often changes no held-out label (closure undefined or 0: `consistent` or `parameter_error`
+//! is then as good an answer as the data allow); turning `parameter_error` 2x is taken for an
+//! `extra_mode`, `speed_dependent_dynamics` 1x for `parameter_error`; the two-mode machine's
+//! `extra_mode` 2x ends `unexplained` (the best class fails the check).
 //!
 //! ```no_run
 //! use chatter_gap::{DiagnoseOptions, HiddenEffect, Scenario, diagnose, nominal_milling, synthesize};
