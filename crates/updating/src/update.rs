@@ -675,6 +675,90 @@ mod tests {
     }
 
     #[test]
+    fn complex_modes_and_residual_terms_take_the_zero_order_cut_likelihood_only() {
+        // 004's model with complex modes, and with residual terms in x: FDM names the field,
+        // the zero-order cut likelihood samples
+        let base = examples::schmitz_2022_rcsa();
+        let modes = base
+            .modes()
+            .iter()
+            .map(|m| m.with_residue_phase(0.2).unwrap())
+            .collect();
+        let complex = base.with_modes(modes).unwrap();
+        let residual = chatter_dynamics::ResidualTerms {
+            upper_m_per_n: 2e-8,
+            lower_per_kg: 0.0,
+        };
+        let with_residuals = base
+            .with_residuals([residual, chatter_dynamics::ResidualTerms::default()])
+            .unwrap();
+        let mut obs = Observations::default();
+        for (depth_mm, stable) in [(0.5, true), (1.0, false)] {
+            obs.cuts.push(Cut {
+                speed_rpm: 10_985.0,
+                depth_mm,
+                stable,
+                chatter_hz: None,
+                sequence: None,
+                radial_immersion: None,
+                note: None,
+                evidence: None,
+            });
+        }
+        let options = SamplerOptions {
+            sampler: Sampler::Itmcmc,
+            samples: 50,
+            seed: 1,
+        };
+        let parameters = Some(vec![ModelParameter::KtNPerMm2]);
+        for (model, field) in [
+            (&complex, "modes[0].residue_phase_deg"),
+            (&with_residuals, "residuals[x]"),
+        ] {
+            let job = |method| {
+                let settings = UpdateSettings {
+                    parameters: parameters.clone(),
+                    method: Some(method),
+                    ..Default::default()
+                };
+                UpdateJob::new(model, &obs, &settings).and_then(|job| job.run(&options, &Silent))
+            };
+            let err = job(Method::Fdm).unwrap_err().to_string();
+            assert!(err.contains(field) && err.contains("fdm"), "{err}");
+            let result = job(Method::Zoa).unwrap();
+            assert!(result.posterior_mean[0].is_finite());
+            // plan after the cuts (paths from the posterior), with FDM: the same refusal
+            let settings = crate::plan::PlanSettings {
+                strategy: crate::plan::Strategy::MaterialRemovalRate,
+                parameters: parameters.clone(),
+                paths: 20,
+                speeds_rpm: Some(vec![10_985.0]),
+                depths_m: Some(vec![0.5e-3, 1e-3]),
+                method: Some(Method::Fdm),
+                ..Default::default()
+            };
+            let err = crate::plan::plan_next_cut(model, &obs, &settings, &Silent)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(field) && err.contains("fdm"), "{err}");
+        }
+        // identified milling poles: the multiplier likelihood refuses a complex mode up front
+        let milling = examples::ebrahimi_2025_milling();
+        let modes = milling
+            .modes()
+            .iter()
+            .map(|m| m.with_residue_phase(0.2).unwrap())
+            .collect();
+        let milling = milling.with_modes(modes).unwrap();
+        let poles = examples::ebrahimi_2025_milling_observations();
+        let err = UpdateJob::new(&milling, &poles, &UpdateSettings::default())
+            .and_then(|job| job.run(&options, &Silent))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("modes[0].residue_phase_deg"), "{err}");
+    }
+
+    #[test]
     fn cut_results_update_the_cutting_coefficient() {
         // stable at 0.3 mm, chatter at 0.9 mm (2100 rpm) on the 002 machine: kn moves to the
         // values whose limit lies between
