@@ -2,7 +2,7 @@
 //! material removal rate on a probability-of-stability contour (004).
 
 use crate::progress::Bar;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use chatter_jobs::plan::PlanRequest;
 
 use chatter_updating::parameters::parse_model_parameters;

@@ -3,7 +3,7 @@
 
 use crate::output::Folder;
 use crate::progress::Bar;
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 use chatter_jobs::inference_data::{Draws, InferenceData};
 use chatter_jobs::update::{PreparedUpdate, UpdateRequest};
 use chatter_progress::Observer;

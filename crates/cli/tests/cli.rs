@@ -813,7 +813,7 @@ fn update_takes_the_004_correlated_prior() {
     // Fisher z of 0.999994 is 6.06; 300 samples (effective 100 or more) put it within 0.4
     assert!((r.atanh() - 0.999994f64.atanh()).abs() < 0.4, "{r}");
     let err = fail(&mut update(
-        &["--method", "zoa"],
+        &["--method", "zoa", "--seed", "1"],
         example("ahmadi2022_turning_model.json"),
         example("ahmadi2022_turning_observations.json"),
         dir.path().join("poles"),
