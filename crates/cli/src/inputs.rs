@@ -2,6 +2,8 @@
 
 use anyhow::{Context, Result};
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_updating::joint_prior::{JointNormal, PriorFile};
+use chatter_updating::update::PriorOverrides;
 use std::path::Path;
 
 /// Read and validate a model file.
@@ -12,4 +14,25 @@ pub fn model(path: &Path) -> Result<ModalModel> {
 /// Read and validate an observations file (JSON or cuts CSV).
 pub fn observations(path: &Path) -> Result<Observations> {
     Observations::from_path(path).context("reading the observations file")
+}
+
+/// Read a priors file (`--priors` of `update` and `plan`): marginals by name, or one correlated
+/// normal `{"parameter_names", "mean", "covariance"}`; without a file, neither.
+pub fn priors(path: Option<&Path>) -> Result<(PriorOverrides, Option<JointNormal>)> {
+    let Some(path) = path else {
+        return Ok((PriorOverrides::new(), None));
+    };
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the priors file {}", path.display()))?;
+    let file = PriorFile::from_json_str(&text).with_context(|| {
+        format!(
+            "{}: invalid priors file (expected marginals by name, or \
+             {{\"parameter_names\", \"mean\", \"covariance\"}})",
+            path.display()
+        )
+    })?;
+    Ok(match file {
+        PriorFile::Marginals(m) => (m, None),
+        PriorFile::Joint(j) => (PriorOverrides::new(), Some(j)),
+    })
 }

@@ -2,14 +2,12 @@
 //! material removal rate on a probability-of-stability contour (004).
 
 use crate::progress::Bar;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use chatter_jobs::plan::PlanRequest;
 
-use chatter_updating::joint_prior::PriorFile;
 use chatter_updating::parameters::parse_model_parameters;
 use chatter_updating::plan::Strategy;
 use chatter_updating::sampled::SampledBoundaries;
-use chatter_updating::update::PriorOverrides;
 use std::path::PathBuf;
 
 /// Test-selection strategies.
@@ -194,23 +192,7 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
             "--speeds",
         )?;
     }
-    let (priors, joint_prior) = match &args.priors {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading the priors file {}", path.display()))?;
-            match PriorFile::from_json_str(&text).with_context(|| {
-                format!(
-                    "{}: invalid priors file (expected marginals by name, or \
-                     {{\"parameter_names\", \"mean\", \"covariance\"}})",
-                    path.display()
-                )
-            })? {
-                PriorFile::Marginals(m) => (m, None),
-                PriorFile::Joint(j) => (PriorOverrides::new(), Some(j)),
-            }
-        }
-        None => (PriorOverrides::new(), None),
-    };
+    let (priors, joint_prior) = crate::inputs::priors(args.priors.as_deref())?;
     let request = PlanRequest {
         strategy: match args.strategy {
             StrategyArg::Voi => Strategy::ValueOfInformation,

@@ -3,13 +3,13 @@
 
 use crate::output::Folder;
 use crate::progress::Bar;
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 use chatter_jobs::inference_data::{Draws, InferenceData};
 use chatter_jobs::update::{PreparedUpdate, UpdateRequest};
 use chatter_progress::Observer;
 use chatter_updating::classes::Sampler;
 use chatter_updating::parameters::parse_model_parameters;
-use chatter_updating::update::{PriorOverrides, UpdateResult};
+use chatter_updating::update::UpdateResult;
 use plotters::prelude::*;
 use std::path::PathBuf;
 
@@ -37,13 +37,20 @@ pub struct UpdateArgs {
     #[arg(long, value_enum, default_value = "itmcmc")]
     sampler: SamplerArg,
     /// Parameters to update, comma-separated (theta_omega_N, theta_zeta_N, theta_phi_N,
-    /// theta_k_N, kt_n_per_mm2, kn_n_per_mm2, c_n_per_m); default: the most sensitive mode's.
+    /// theta_k_N, kt_n_per_mm2, kn_n_per_mm2, c_n_per_m, ks_n_per_mm2, beta_deg, fnN_hz,
+    /// kN_n_per_m, zetaN); default: the most sensitive mode's.
     #[arg(long)]
     parameters: Option<String>,
-    /// Priors file: {"NAME": {"kind": "uniform"|"normal"|"truncated_normal"|"log_normal", ...}};
-    /// unnamed parameters keep the papers' priors.
+    /// Priors file: {"NAME": {"kind": "uniform"|"normal"|"truncated_normal"|"log_normal", ...}}
+    /// (unnamed parameters keep the papers' priors), or a correlated normal
+    /// {"parameter_names", "mean", "covariance"} (e.g. examples/schmitz2022_rcsa_prior.json; its names are
+    /// then the updated parameters unless --parameters is given).
     #[arg(long)]
     priors: Option<PathBuf>,
+    /// Stability method of the cut likelihood (cut results only): fdm (default), sdm, or zoa
+    /// (the zero-order method 004 used; complex modes and residual terms need it).
+    #[arg(long, value_enum)]
+    method: Option<crate::commands::Method>,
     /// Model classes alpha, comma-separated; default 2^-5.5..2^2 (turning), 0.001..1 (milling).
     #[arg(long)]
     classes: Option<String>,
@@ -144,15 +151,7 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     let model = crate::inputs::model(&args.model)?;
     let observations = crate::inputs::observations(&args.observations)?;
     crate::validate::observations_match(&model, &observations, &args.observations, &args.model)?;
-    let priors: PriorOverrides = match &args.priors {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading the priors file {}", path.display()))?;
-            serde_json::from_str(&text)
-                .with_context(|| format!("{}: invalid priors file", path.display()))?
-        }
-        None => PriorOverrides::new(),
-    };
+    let (priors, joint_prior) = crate::inputs::priors(args.priors.as_deref())?;
     crate::validate::count(
         "--surrogate-points",
         args.surrogate_points,
@@ -174,6 +173,8 @@ pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
             .map(parse_model_parameters)
             .transpose()?,
         priors,
+        joint_prior,
+        method: args.method,
         classes: args.classes.as_deref().map(parse_classes).transpose()?,
         surrogate_points: match args.surrogate {
             Some(SurrogateArg::Gp) | None => Some(args.surrogate_points),

@@ -764,6 +764,66 @@ fn plan_takes_the_004_correlated_prior() {
     );
 }
 
+/// `chatter update` on a few cuts with 004's correlated prior file and the zero-order cut
+/// likelihood: the eight prior names are the updated parameters, and the posterior keeps the
+/// modal block's correlation (corr(f_n1, k_1) = 0.999994 in the prior, where the cuts say
+/// nothing); `--method` with identified poles is refused naming it.
+#[test]
+fn update_takes_the_004_correlated_prior() {
+    let dir = tempfile::tempdir().unwrap();
+    let cuts = dir.path().join("cuts.json");
+    std::fs::write(
+        &cuts,
+        r#"{"cuts": [{"speed_rpm": 10985, "depth_mm": 0.65, "stable": true},
+                     {"speed_rpm": 10985, "depth_mm": 0.7, "stable": false},
+                     {"speed_rpm": 10000, "depth_mm": 0.6, "stable": false}]}"#,
+    )
+    .unwrap();
+    let out_dir = dir.path().join("posterior");
+    let priors = example("schmitz2022_rcsa_prior.json");
+    let options = |method: &'static str| {
+        vec![
+            "--samples".to_string(),
+            "300".into(),
+            "--seed".into(),
+            "2".into(),
+            "--method".into(),
+            method.into(),
+            "--priors".into(),
+            priors.to_str().unwrap().into(),
+        ]
+    };
+    let zoa = options("zoa");
+    let zoa: Vec<&str> = zoa.iter().map(String::as_str).collect();
+    succeed(&mut update(
+        &zoa,
+        example("schmitz2022_rcsa_model.json"),
+        &cuts,
+        &out_dir,
+    ));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let names = summary["parameter_names"].as_array().unwrap();
+    assert_eq!(names.len(), 8);
+    assert_eq!(names[2], "fn1_hz");
+    assert_eq!(names[3], "k1_n_per_m");
+    let c = |i: usize, j: usize| summary["posterior_covariance"][i][j].as_f64().unwrap();
+    let r = c(2, 3) / (c(2, 2) * c(3, 3)).sqrt();
+    // Fisher z of 0.999994 is 6.06; 300 samples (effective 100 or more) put it within 0.4
+    assert!((r.atanh() - 0.999994f64.atanh()).abs() < 0.4, "{r}");
+    let err = fail(&mut update(
+        &["--method", "zoa", "--seed", "1"],
+        example("ahmadi2022_turning_model.json"),
+        example("ahmadi2022_turning_observations.json"),
+        dir.path().join("poles"),
+    ));
+    assert!(
+        err.contains("method") && err.contains("cut results only"),
+        "{err}"
+    );
+}
+
 /// `chatter oma` on a small signal file: a seeded 800 Hz mode (zeta 2 %) on two channels plus a
 /// once-per-revolution tachometer at 7150 rpm, 4 s at 10 kHz. The pole comes back in the
 /// observations schema (frequency within 0.4 %, damping within 20 %, ten repetitions), the

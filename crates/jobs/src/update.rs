@@ -6,6 +6,7 @@ use crate::error::{Result, count};
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_progress::Observer;
 use chatter_updating::classes::{Sampler, SamplerOptions};
+use chatter_updating::joint_prior::JointNormal;
 use chatter_updating::parameters::ModelParameter;
 use chatter_updating::update::{PriorOverrides, UpdateJob, UpdateResult, UpdateSettings};
 
@@ -29,6 +30,11 @@ pub struct UpdateRequest {
     pub parameters: Option<Vec<ModelParameter>>,
     /// Priors by parameter name.
     pub priors: PriorOverrides,
+    /// A correlated normal prior over some parameters (e.g. 004's RCSA prior file).
+    pub joint_prior: Option<JointNormal>,
+    /// Stability method of the cut likelihood (cut results only; default the full
+    /// discretization).
+    pub method: Option<chatter_stability::prepared::Method>,
     /// Model classes alpha (default: the papers').
     pub classes: Option<Vec<f64>>,
     /// Milling poles: GP surrogate training points (`None`: the exact multiplier per sample).
@@ -45,6 +51,8 @@ impl UpdateRequest {
             seed,
             parameters: None,
             priors: PriorOverrides::new(),
+            joint_prior: None,
+            method: None,
             classes: None,
             surrogate_points: Some(chatter_updating::surrogate::DEFAULT_TRAINING_POINTS),
         }
@@ -87,6 +95,8 @@ impl PreparedUpdate {
         let settings = UpdateSettings {
             parameters: request.parameters.clone(),
             priors: request.priors.clone(),
+            joint_prior: request.joint_prior.clone(),
+            method: request.method,
             classes: request.classes.clone(),
             surrogate_training_points: request.surrogate_points,
         };

@@ -95,7 +95,9 @@ pub struct CutsLikelihood {
 }
 
 impl CutsLikelihood {
-    /// Build from the parameterization, the cuts (at least one) and the kernel.
+    /// Build from the parameterization, the cuts (at least one) and the kernel; an error naming
+    /// the field when the method cannot take the model (FDM or SDM with complex modes or
+    /// residual terms, [`chatter_dynamics::ModalModel::require_proportional`]).
     pub fn new(
         parameterization: Parameterization,
         cuts: Vec<Cut>,
@@ -106,6 +108,13 @@ impl CutsLikelihood {
             return Err(UpdatingError::Observations("no test cuts".into()));
         }
         let kernel = kernel.validated()?;
+        // a discretization that cannot take the model (complex modes, residual terms) would fail
+        // at every sample, which the samplers count as numerical failures: say so here instead
+        if options.method.discretization().is_some() {
+            parameterization
+                .nominal()
+                .require_proportional(options.method.name())?;
+        }
         let mut speeds_rpm: Vec<f64> = Vec::new();
         let speed_of = cuts
             .iter()

@@ -23,10 +23,10 @@
 //! grid depth with P_s >= P_test) the test is the point of maximum material removal rate; testing
 //! stops when the next test would improve the best stable MRR by less than 10 %.
 
-use crate::classes::{Sampler, SamplerOptions, sample_posterior};
+use crate::classes::{Sampler, SamplerOptions};
 use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
-use crate::joint_prior::{SampledPrior, WhitenedLikelihood, WhitenedPrior};
+use crate::joint_prior::{SampledPrior, sample_posterior_whitened};
 use crate::parameters::Parameterization;
 use crate::sampled::{SampledBoundaries, boundary_of};
 use chatter_bayes::Prior;
@@ -202,13 +202,9 @@ impl BoundaryEnsemble {
                 samples: paths,
                 seed,
             };
-            let whitened = WhitenedLikelihood {
+            sample_posterior_whitened(
                 prior,
-                likelihood: &likelihood,
-            };
-            sample_posterior(
-                &WhitenedPrior(prior),
-                &whitened,
+                likelihood.clone(),
                 &settings,
                 &chatter_progress::Silent,
             )
@@ -219,13 +215,7 @@ impl BoundaryEnsemble {
             }) => draw(Sampler::Itmcmc)?,
             other => other?,
         };
-        let set = &posterior.samples;
-        let samples = set
-            .samples()
-            .iter()
-            .map(|z| prior.from_whitened(z))
-            .collect();
-        let set = SampleSet::new(samples, set.weights().to_vec())?;
+        let set = posterior.samples;
         Self::from_sample_set(parameterization, &set, speeds_rpm, options, observer)
     }
 

@@ -19,12 +19,17 @@
 //! Sigma = L L^T, the other parameters unchanged, so the block's prior is N(0, I); the samples
 //! are mapped back by u = mu + L z (the Jacobian |det L| is a constant).
 
+use crate::classes::{
+    ClassSelection, Posterior, SamplerOptions, sample_posterior, select_model_class,
+};
 use crate::error::{Result, UpdatingError};
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::update::PriorOverrides;
 use chatter_bayes::Prior;
 use chatter_bayes::prior::{Marginal, MultivariateNormalPrior};
+use chatter_bayes::samples::SampleSet;
 use chatter_bayes::tmcmc::{LikelihoodFailure, LogLikelihood};
+use chatter_progress::Observer;
 
 /// Draws of a truncated prior tried before giving up (the last one is then returned, and the
 /// model built from it fails with its own error message).
@@ -99,7 +104,8 @@ impl JointNormal {
 }
 
 /// The prior of a parameterization: an optional correlated normal block, independent marginals
-/// for the rest, truncated to valid models (module docs).
+/// for the rest, truncated to valid models (module docs). Nuisance parameters (the error
+/// variance of pole data) may follow the model parameters in theta; they have marginals only.
 #[derive(Debug, Clone)]
 pub struct SampledPrior {
     parameterization: Parameterization,
@@ -115,11 +121,35 @@ impl SampledPrior {
     /// parameter is an error: the block sets its prior.
     pub fn new(
         parameterization: Parameterization,
-        mut marginals: Vec<Marginal>,
+        marginals: Vec<Marginal>,
         overrides: &PriorOverrides,
         joint: Option<&JointNormal>,
     ) -> Result<Self> {
-        let names = parameterization.names();
+        Self::with_nuisance(parameterization, marginals, &[], overrides, joint)
+    }
+
+    /// As [`Self::new`], with nuisance parameters named `nuisance` after the model parameters:
+    /// `marginals` covers the model parameters, then the nuisance ones.
+    pub fn with_nuisance(
+        parameterization: Parameterization,
+        mut marginals: Vec<Marginal>,
+        nuisance: &[String],
+        overrides: &PriorOverrides,
+        joint: Option<&JointNormal>,
+    ) -> Result<Self> {
+        let mut names = parameterization.names();
+        names.extend(nuisance.iter().cloned());
+        if marginals.len() != names.len() {
+            return Err(UpdatingError::InvalidInput {
+                field: "priors",
+                message: format!(
+                    "{} marginals for {} parameters ({})",
+                    marginals.len(),
+                    names.len(),
+                    names.join(", ")
+                ),
+            });
+        }
         for (name, spec) in overrides {
             let k = names.iter().position(|n| n == name).ok_or_else(|| {
                 UpdatingError::InvalidInput {
@@ -211,6 +241,28 @@ impl SampledPrior {
         theta
     }
 
+    /// Whether the model parameters of `theta` give a model (the truncation).
+    fn valid(&self, theta: &[f64]) -> bool {
+        let d = self.parameterization.dimension();
+        theta.len() >= d && self.parameterization.model(&theta[..d]).is_ok()
+    }
+
+    /// The marginal prior of every sampled parameter: its own, or for a block parameter the
+    /// normal N(mu_k, Sigma_kk) (before truncation), e.g. for prior boxes and bound checks.
+    pub fn marginals(&self) -> Vec<Marginal> {
+        let mut all = self.marginals.clone();
+        if let Some((positions, normal)) = &self.block {
+            for (i, &k) in positions.iter().enumerate() {
+                all[k] = Some(Marginal::Normal {
+                    mean: normal.mean()[i],
+                    sd: normal.covariance()[(i, i)].sqrt(),
+                });
+            }
+        }
+        // every parameter is either outside the block (its marginal) or inside it
+        all.into_iter().flatten().collect()
+    }
+
     /// ln p(theta) before truncation.
     fn untruncated_ln_pdf(&self, theta: &[f64]) -> f64 {
         let mut ln_p: f64 = self
@@ -237,7 +289,7 @@ impl Prior for SampledPrior {
             return f64::NEG_INFINITY;
         }
         let ln_p = self.untruncated_ln_pdf(theta);
-        if ln_p.is_finite() && self.parameterization.model(theta).is_err() {
+        if ln_p.is_finite() && !self.valid(theta) {
             return f64::NEG_INFINITY;
         }
         ln_p
@@ -256,7 +308,7 @@ impl Prior for SampledPrior {
                     theta[k] = v;
                 }
             }
-            if self.parameterization.model(&theta).is_ok() {
+            if self.valid(&theta) {
                 break;
             }
         }
@@ -282,12 +334,12 @@ impl Prior for WhitenedPrior<'_> {
 }
 
 /// A likelihood evaluated at theta(z), for samplers that run in whitened coordinates.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct WhitenedLikelihood<'a, L> {
     /// The prior that defines the coordinates.
     pub prior: &'a SampledPrior,
     /// The likelihood in theta.
-    pub likelihood: &'a L,
+    pub likelihood: L,
 }
 
 impl<L: LogLikelihood> LogLikelihood for WhitenedLikelihood<'_, L> {
@@ -298,6 +350,63 @@ impl<L: LogLikelihood> LogLikelihood for WhitenedLikelihood<'_, L> {
         self.likelihood
             .try_ln_likelihood(&self.prior.from_whitened(z))
     }
+}
+
+impl SampledPrior {
+    /// A posterior sampled in whitened coordinates with its samples mapped back to theta (the
+    /// weights, evidence and data fit do not change: the map is affine).
+    fn unwhitened(&self, posterior: Posterior) -> Result<Posterior> {
+        let set = &posterior.samples;
+        let samples = set
+            .samples()
+            .iter()
+            .map(|z| self.from_whitened(z))
+            .collect();
+        Ok(Posterior {
+            samples: SampleSet::new(samples, set.weights().to_vec())?,
+            ..posterior
+        })
+    }
+}
+
+/// [`sample_posterior`] run in the whitened coordinates of `prior` (module docs), the samples
+/// returned in theta.
+pub fn sample_posterior_whitened<L: LogLikelihood>(
+    prior: &SampledPrior,
+    likelihood: L,
+    options: &SamplerOptions,
+    observer: &dyn Observer,
+) -> Result<Posterior> {
+    let whitened = WhitenedLikelihood { prior, likelihood };
+    prior.unwhitened(sample_posterior(
+        &WhitenedPrior(prior),
+        &whitened,
+        options,
+        observer,
+    )?)
+}
+
+/// [`select_model_class`] run in the whitened coordinates of `prior`, every class's samples
+/// returned in theta.
+pub fn select_model_class_whitened<L, F>(
+    prior: &SampledPrior,
+    alphas: &[f64],
+    likelihood: F,
+    options: &SamplerOptions,
+    observer: &dyn Observer,
+) -> Result<ClassSelection>
+where
+    L: LogLikelihood,
+    F: Fn(f64) -> Result<L>,
+{
+    let whitened =
+        |alpha| likelihood(alpha).map(|likelihood| WhitenedLikelihood { prior, likelihood });
+    let mut selection =
+        select_model_class(&WhitenedPrior(prior), alphas, whitened, options, observer)?;
+    for class in &mut selection.classes {
+        class.posterior = prior.unwhitened(class.posterior.clone())?;
+    }
+    Ok(selection)
 }
 
 #[cfg(test)]

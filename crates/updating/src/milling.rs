@@ -108,6 +108,10 @@ impl MillingPoleLikelihood {
         if poles.is_empty() {
             return Err(UpdatingError::Observations("no identified poles".into()));
         }
+        // the monodromy needs real modal coordinates: name the field now, not at every sample
+        parameterization
+            .nominal()
+            .require_proportional(discretization.scheme.name())?;
         if !(alpha.is_finite() && alpha > 0.0) {
             return Err(UpdatingError::InvalidInput {
                 field: "alpha",

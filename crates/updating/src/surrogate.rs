@@ -300,7 +300,7 @@ pub const LOCAL_TRAINING_POINTS: usize = 100;
 pub fn refined_for_class(
     likelihood: &MillingPoleLikelihood,
     global: Arc<PoleSurrogate>,
-    prior: &chatter_bayes::prior::IndependentPrior,
+    prior: &crate::joint_prior::SampledPrior,
     samples: usize,
     seed: u64,
 ) -> Result<Arc<PoleSurrogate>> {
@@ -314,8 +314,12 @@ pub fn refined_for_class(
     let mut current = global;
     for _ in 0..REFINEMENTS {
         let like = likelihood.clone().with_surrogate(current.clone());
-        let pilot =
-            crate::classes::sample_posterior(prior, &like, &options, &chatter_progress::Silent)?;
+        let pilot = crate::joint_prior::sample_posterior_whitened(
+            prior,
+            like,
+            &options,
+            &chatter_progress::Silent,
+        )?;
         let boxes: Vec<(f64, f64)> = (0..d)
             .map(|k| {
                 let (lo, hi) = pilot

@@ -8,22 +8,26 @@
 //! s_S = 0.125 mm and s_fc = 50 Hz) as a single class.
 //! Parameters, priors and classes default to the papers' ([`crate::defaults`]).
 
-use crate::classes::{SamplerOptions, sample_posterior, select_model_class};
+use crate::classes::SamplerOptions;
 use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::defaults::{
     MILLING_ERROR_VARIANCE, TURNING_ERROR_VARIANCE, default_parameters, error_variance_prior,
     milling_alphas, parameter_prior, turning_alphas,
 };
 use crate::error::{Result, UpdatingError};
+use crate::joint_prior::{
+    JointNormal, SampledPrior, sample_posterior_whitened, select_model_class_whitened,
+};
 use crate::milling::MillingPoleLikelihood;
 use crate::parameters::{ModelParameter, Parameterization};
 use crate::turning::{ResidualForm, TurningPoleLikelihood, expand_repetitions};
-use chatter_bayes::prior::{IndependentPrior, Marginal};
+use chatter_bayes::Prior;
+use chatter_bayes::prior::Marginal;
 use chatter_bayes::samples::SampleSet;
 use chatter_dynamics::{Cut, ModalModel, Observations, Operation, PoleObservation};
 use chatter_progress::Observer;
 use chatter_stability::monodromy::Discretization;
-use chatter_stability::prepared::SolverOptions;
+use chatter_stability::prepared::{Method, SolverOptions};
 use nalgebra::DMatrix;
 use std::collections::BTreeMap;
 
@@ -47,8 +51,16 @@ pub struct UpdateSettings {
     pub parameters: Option<Vec<ModelParameter>>,
     /// Priors by name.
     pub priors: PriorOverrides,
+    /// A correlated normal prior over some of the parameters (a prior file
+    /// `{parameter_names, mean, covariance}`, e.g. 004's RCSA prior), which then sets their
+    /// prior; without `parameters` its names are the updated parameters. The samplers run in
+    /// its whitened coordinates ([`crate::joint_prior`]).
+    pub joint_prior: Option<JointNormal>,
     /// Model classes alpha.
     pub classes: Option<Vec<f64>>,
+    /// Stability method of the cut likelihood (default [`SolverOptions`]'s: the full
+    /// discretization; 004 used the zero-order method). Cut results only.
+    pub method: Option<Method>,
     /// Milling poles: replace the exact multipliers by a GP surrogate trained on this many
     /// points of the prior box ([`crate::surrogate`], 002 Section 2.2). Ignored otherwise.
     pub surrogate_training_points: Option<usize>,
@@ -58,10 +70,12 @@ pub struct UpdateSettings {
 #[derive(Debug, Clone)]
 pub struct UpdateJob {
     parameterization: Parameterization,
-    prior: IndependentPrior,
+    prior: SampledPrior,
     names: Vec<String>,
     alphas: Vec<f64>,
     data: Data,
+    /// Stability solver of the cut likelihood.
+    solver: SolverOptions,
     surrogate_training_points: Option<usize>,
     poles: Vec<PoleObservation>,
 }
@@ -171,7 +185,10 @@ impl UpdateJob {
                     message: "empty list".into(),
                 });
             }
-            None => default_parameters(model, poles)?,
+            None => match &settings.joint_prior {
+                Some(joint) => joint.parameters()?,
+                None => default_parameters(model, poles)?,
+            },
         };
         let parameterization = Parameterization::new(model.clone(), parameters)?;
         let mut names = parameterization.names();
@@ -207,30 +224,39 @@ impl UpdateJob {
             };
             (data, alphas)
         };
+        if let (Some(method), false) = (settings.method, matches!(data, Data::Cuts(_))) {
+            return Err(UpdatingError::InvalidInput {
+                field: "method",
+                message: format!(
+                    "{}: the stability method applies to cut results only, and these \
+                     observations have identified poles (their likelihoods use the exact poles)",
+                    method.name()
+                ),
+            });
+        }
         if let Some(a) = alphas.iter().find(|a| !(a.is_finite() && **a > 0.0)) {
             return Err(UpdatingError::InvalidInput {
                 field: "classes",
                 message: format!("alpha {a}; expected > 0"),
             });
         }
-        for (name, spec) in &settings.priors {
-            let k = names.iter().position(|n| n == name).ok_or_else(|| {
-                UpdatingError::InvalidInput {
-                    field: "priors",
-                    message: format!(
-                        "`{name}` is not an updated parameter (updating {})",
-                        names.join(", ")
-                    ),
-                }
-            })?;
-            marginals[k] = *spec;
-        }
+        let nuisance = &names[parameterization.dimension()..];
+        let prior = SampledPrior::with_nuisance(
+            parameterization.clone(),
+            marginals,
+            nuisance,
+            &settings.priors,
+            settings.joint_prior.as_ref(),
+        )?;
         Ok(Self {
             parameterization,
-            prior: IndependentPrior::new(marginals)?,
+            prior,
             names,
             alphas,
             data,
+            solver: settings
+                .method
+                .map_or_else(SolverOptions::default, SolverOptions::new),
             surrogate_training_points: settings.surrogate_training_points,
             poles: poles.clone(),
         })
@@ -246,8 +272,8 @@ impl UpdateJob {
         &self.alphas
     }
 
-    /// The joint prior.
-    pub fn prior(&self) -> &IndependentPrior {
+    /// The joint prior (marginals, or a correlated block times marginals).
+    pub fn prior(&self) -> &SampledPrior {
         &self.prior
     }
 
@@ -256,15 +282,7 @@ impl UpdateJob {
     pub fn prior_draws(&self, n: usize, seed: u64) -> Vec<Vec<f64>> {
         use rand::SeedableRng;
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        (0..n)
-            .map(|_| {
-                self.prior
-                    .marginals()
-                    .iter()
-                    .map(|m| m.sample(&mut rng))
-                    .collect()
-            })
-            .collect()
+        (0..n).map(|_| self.prior.sample(&mut rng)).collect()
     }
 
     /// Sample every class and summarize the selected one.
@@ -278,9 +296,9 @@ impl UpdateJob {
                     p.clone(),
                     cuts.clone(),
                     CutKernel::schmitz(),
-                    SolverOptions::default(),
+                    self.solver,
                 )?;
-                let post = sample_posterior(&self.prior, &like, options, observer)?;
+                let post = sample_posterior_whitened(&self.prior, like, options, observer)?;
                 let class = ClassSummary {
                     alpha: None,
                     log_evidence: post.log_evidence,
@@ -300,7 +318,7 @@ impl UpdateJob {
                         ResidualForm::PoleError,
                     )
                 };
-                summarize(select_model_class(
+                summarize(select_model_class_whitened(
                     &self.prior,
                     &self.alphas,
                     make,
@@ -348,7 +366,7 @@ impl UpdateJob {
                         None => like,
                     })
                 };
-                let (samples, classes, alpha) = summarize(select_model_class(
+                let (samples, classes, alpha) = summarize(select_model_class_whitened(
                     &self.prior,
                     &self.alphas,
                     make,
@@ -368,8 +386,11 @@ impl UpdateJob {
         let mean = samples.mean();
         let updated_model = p.model(&mean[..p.dimension()])?;
         let pole_table = self.pole_table(&mean[..p.dimension()])?;
-        let prior_bound_pileups =
-            crate::prior_bounds::prior_bound_pileups(&self.names, self.prior.marginals(), &samples);
+        let prior_bound_pileups = crate::prior_bounds::prior_bound_pileups(
+            &self.names,
+            &self.prior.marginals(),
+            &samples,
+        );
         Ok(UpdateResult {
             pole_table,
             prior_bound_pileups,
@@ -410,7 +431,7 @@ impl UpdateJob {
                         p.clone(),
                         vec![c.clone()],
                         CutKernel::schmitz(),
-                        SolverOptions::default(),
+                        self.solver,
                     )
                     .map(|l| Box::new(l) as Box<dyn LogLikelihood>)
                 })
@@ -642,6 +663,99 @@ mod tests {
             ..Default::default()
         };
         assert!(UpdateJob::new(&model, &obs, &settings).is_err());
+        // a stability method is for cut results; poles use their exact likelihoods
+        let settings = UpdateSettings {
+            method: Some(Method::Zoa),
+            ..Default::default()
+        };
+        let err = UpdateJob::new(&model, &obs, &settings)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("method") && err.contains("zoa"), "{err}");
+    }
+
+    #[test]
+    fn complex_modes_and_residual_terms_take_the_zero_order_cut_likelihood_only() {
+        // 004's model with complex modes, and with residual terms in x: FDM names the field,
+        // the zero-order cut likelihood samples
+        let base = examples::schmitz_2022_rcsa();
+        let modes = base
+            .modes()
+            .iter()
+            .map(|m| m.with_residue_phase(0.2).unwrap())
+            .collect();
+        let complex = base.with_modes(modes).unwrap();
+        let residual = chatter_dynamics::ResidualTerms {
+            upper_m_per_n: 2e-8,
+            lower_per_kg: 0.0,
+        };
+        let with_residuals = base
+            .with_residuals([residual, chatter_dynamics::ResidualTerms::default()])
+            .unwrap();
+        let mut obs = Observations::default();
+        for (depth_mm, stable) in [(0.5, true), (1.0, false)] {
+            obs.cuts.push(Cut {
+                speed_rpm: 10_985.0,
+                depth_mm,
+                stable,
+                chatter_hz: None,
+                sequence: None,
+                radial_immersion: None,
+                note: None,
+                evidence: None,
+            });
+        }
+        let options = SamplerOptions {
+            sampler: Sampler::Itmcmc,
+            samples: 50,
+            seed: 1,
+        };
+        let parameters = Some(vec![ModelParameter::KtNPerMm2]);
+        for (model, field) in [
+            (&complex, "modes[0].residue_phase_deg"),
+            (&with_residuals, "residuals[x]"),
+        ] {
+            let job = |method| {
+                let settings = UpdateSettings {
+                    parameters: parameters.clone(),
+                    method: Some(method),
+                    ..Default::default()
+                };
+                UpdateJob::new(model, &obs, &settings).and_then(|job| job.run(&options, &Silent))
+            };
+            let err = job(Method::Fdm).unwrap_err().to_string();
+            assert!(err.contains(field) && err.contains("fdm"), "{err}");
+            let result = job(Method::Zoa).unwrap();
+            assert!(result.posterior_mean[0].is_finite());
+            // plan after the cuts (paths from the posterior), with FDM: the same refusal
+            let settings = crate::plan::PlanSettings {
+                strategy: crate::plan::Strategy::MaterialRemovalRate,
+                parameters: parameters.clone(),
+                paths: 20,
+                speeds_rpm: Some(vec![10_985.0]),
+                depths_m: Some(vec![0.5e-3, 1e-3]),
+                method: Some(Method::Fdm),
+                ..Default::default()
+            };
+            let err = crate::plan::plan_next_cut(model, &obs, &settings, &Silent)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(field) && err.contains("fdm"), "{err}");
+        }
+        // identified milling poles: the multiplier likelihood refuses a complex mode up front
+        let milling = examples::ebrahimi_2025_milling();
+        let modes = milling
+            .modes()
+            .iter()
+            .map(|m| m.with_residue_phase(0.2).unwrap())
+            .collect();
+        let milling = milling.with_modes(modes).unwrap();
+        let poles = examples::ebrahimi_2025_milling_observations();
+        let err = UpdateJob::new(&milling, &poles, &UpdateSettings::default())
+            .and_then(|job| job.run(&options, &Silent))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("modes[0].residue_phase_deg"), "{err}");
     }
 
     #[test]
