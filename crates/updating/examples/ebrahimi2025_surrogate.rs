@@ -19,7 +19,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let samples: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(1000);
     let alpha: f64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(0.1);
-    let points: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(chatter_updating::surrogate::DEFAULT_TRAINING_POINTS);
+    let points: usize = args
+        .next()
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(chatter_updating::surrogate::DEFAULT_TRAINING_POINTS);
     let model = examples::ebrahimi_2025_milling();
     let obs = examples::ebrahimi_2025_milling_observations();
     let options = SamplerOptions {

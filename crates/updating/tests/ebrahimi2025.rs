@@ -7,10 +7,7 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_bayes::prior::{IndependentPrior, Marginal};
-use chatter_dynamics::{
-    CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
-    PoleObservation,
-};
+use chatter_dynamics::{ModalModel, PoleObservation};
 use chatter_progress::Silent;
 use chatter_stability::monodromy::Discretization;
 use chatter_updating::classes::{Sampler, SamplerOptions, sample_posterior};
@@ -18,24 +15,8 @@ use chatter_updating::milling::MillingPoleLikelihood;
 use chatter_updating::parameters::{Parameterization, parse_model_parameters};
 
 fn simulated_setup() -> ModalModel {
-    let mode = Mode::new(
-        194.0,
-        0.005,
-        ModeShape::Directional {
-            coordinate: 0,
-            stiffness_n_per_m: 2.35e6,
-        },
-    )
-    .unwrap();
-    let op = Operation::Milling(
-        Milling::new(2, 1.0, MillingDirection::Down, Some(12.7e-3), None).unwrap(),
-    );
-    ModalModel::new(
-        Some("002 numerical simulation".into()),
-        op,
-        CuttingCoefficients::new(650e6, 110e6).unwrap(),
-        vec![mode],
-        None,
+    chatter_updating::ebrahimi2025::simulated_model(
+        chatter_updating::ebrahimi2025::STATED_FREQUENCY_HZ,
     )
     .unwrap()
 }
