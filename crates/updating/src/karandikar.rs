@@ -30,8 +30,9 @@
 //! paper's own numbers give D a reduction of 0.7 %, ours 1.6 %. The calibration scan (stiffness,
 //! damping ratio, mode direction; and a process-damping force 2-8 times ours, as if the
 //! algorithm added C b / V to the flexure's damping outright instead of over the tooth's time
-//! in the cut) raised D's reduction to 18-23 % only where A, B and C became stable on nearly
-//! every path (P_s 0.89-1.00). So D's reduction stays outside its tolerance, shown as such in
+//! in the cut; 300-400 paths) raised D's reduction to 13-31 % only where C (1500 rpm, paper
+//! P_s 0.1) became stable on 62-96 % of the paths and the 1000 rpm / 4 mm P_s rose to
+//! 0.72-0.98 (paper 0.25). So D's reduction stays outside its tolerance, shown as such in
 //! `chatter demo`'s papers table; the paper's paths come from Tyler and Schmitz's algorithm
 //! (its ref. 16, not in the seeds), whose details may differ.
 //!
