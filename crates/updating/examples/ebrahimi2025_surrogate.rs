@@ -3,9 +3,12 @@
 //!
 //! Trains the surrogate, prints its held-out pole errors and training time, then updates one
 //! model class with the surrogate and with the exact likelihood and compares the posterior
-//! means in units of the exact posterior's standard deviation.
+//! means in units of the exact posterior's standard deviation, against the issue's tolerance of
+//! one standard deviation (issue 18; the reduced test is
+//! `tests/ebrahimi2025.rs::surrogate_posterior_mean_is_within_one_exact_sd`).
 //!
 //! `cargo run --release -p chatter-updating --example ebrahimi2025_surrogate [SAMPLES] [ALPHA] [POINTS]`
+//! (defaults 1000 samples, alpha 0.1 (the class the update selects), the CLI's 200 points)
 use chatter_dynamics::examples;
 use chatter_progress::Silent;
 use chatter_updating::classes::{Sampler, SamplerOptions};
@@ -16,7 +19,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let samples: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(1000);
     let alpha: f64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(0.1);
-    let points: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(400);
+    let points: usize = args
+        .next()
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(chatter_updating::surrogate::DEFAULT_TRAINING_POINTS);
     let model = examples::ebrahimi_2025_milling();
     let obs = examples::ebrahimi_2025_milling_observations();
     let options = SamplerOptions {
@@ -105,5 +111,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     println!("posterior mean shift in exact posterior sd: {shift:.2?}");
+    let worst = shift.iter().fold(0.0_f64, |m, s| m.max(s.abs()));
+    println!(
+        "largest |shift| {worst:.2} sd: {} (tolerance 1 sd)",
+        if worst <= 1.0 { "within" } else { "OUTSIDE" }
+    );
     Ok(())
 }

@@ -105,6 +105,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mark(ok)
         );
     }
+    println!(
+        "  D's reduction is a documented deviation: the paper's 24.9 % needs the 2000 rpm limit to\n  \
+         span ~3 mm over the C prior, which Eq. 1's C b / V does not give with its B and Fig. 8\n  \
+         (chatter_updating::karandikar docs; python3 crates/updating/examples/karandikar_point_d.py)"
+    );
     // why D's reduction is small here: how much C moves the limit at each candidate speed
     println!(
         "\nlimiting depth (mm) at the nominal kt, kn against C (0.5e5, 2.5e5, 5e5, 7.5e5, 10e5 N/m):"

@@ -11,6 +11,7 @@
 //! | [`classes`] | iTMCMC / TMCMC / rejection + adaptive MCMC, evidence-based class selection | 000 Eq. 32-33 |
 //! | [`sampled`] | sampled stability boundaries (limits and chatter frequencies per sample and speed, probabilities, failures), P_s maps and quantile bands | 003 Eq. 7, 004 Eq. 8, Fig. 2 |
 //! | [`ensemble`] | random-walk paths: updating, posterior moments, value of information; risk-based test at maximum MRR | 003 Eq. 2-6, 004 Section 3 |
+//! | [`ebrahimi2025`] | 002's simulated system and Table 1's poles beside the exact monodromy poles (at the stated 194 Hz and at 195.3 Hz) | 002 Sec. 3.1 |
 //! | [`schmitz2022`] | 004's example with its correlated RCSA prior: the paper's numbers beside ours | 004 Sec. 2, 3, 6 |
 //! | [`karandikar`] | 003's prior, Table 2's candidate tests with the paper's numbers, RSS identification of C | 003 |
 //! | [`surrogate`] | Matérn GP surrogate of the dominant milling multiplier, with its error against the exact one | 002 Section 2.2 |
@@ -44,6 +45,7 @@
 pub mod classes;
 pub mod cuts;
 pub mod defaults;
+pub mod ebrahimi2025;
 pub mod ensemble;
 pub mod error;
 pub mod joint_prior;

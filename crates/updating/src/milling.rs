@@ -24,8 +24,10 @@
 //! 002's simulated poles (Table 1) are not those of its stated simulation model (194 Hz): its
 //! lifted frequencies sit a constant 1.2 Hz from the monodromy poles of that model
 //! (2000 rpm / 0.5 mm: 4.6 Hz in the table, 5.85 Hz at 194 Hz), and the experimental hammer
-//! frequency 195.3 Hz removes the offset (4.63 Hz; 2100 rpm / 0.4 mm: 14.05 against 14.06 Hz),
-//! so the table was most likely simulated with 195.3 Hz. A table of mean and standard deviation
+//! frequency 195.3 Hz removes the offset (4.63 Hz; 2100 rpm / 0.4 mm: 14.05 against 14.06 Hz);
+//! its damping ratios, though, the stated 194 Hz reproduces and 195.3 Hz does not (at 2000 rpm
+//! 0.030-0.038 too high): no one model reproduces the table
+//! ([`crate::ebrahimi2025`] shows both). A table of mean and standard deviation
 //! s over n repetitions enters exactly through sum_j (x_j - m)^2 = n (x_mean - m)^2 + (n - 1) s^2.
 //! theta = [model parameters..., sigma_w^2 (Hz^2)].
 //!

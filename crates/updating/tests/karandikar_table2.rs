@@ -1,8 +1,9 @@
 //! Seed 003's Table 2 on the calibrated flexure (`examples/karandikar_flexure_model.json`):
 //! prior probability of stability and expected percent reduction of sigma_C at the candidate
 //! tests, against the paper within 0.1 and 5 points (issue 18). D's expected reduction is not
-//! reproduced (ours ~1.5 % against 24.9 %: on this flexure the process-damped limit at 2000 rpm
-//! hardly depends on C; `examples/karandikar.rs` prints it), so only D's P_s is held.
+//! reproduced (ours ~1.5 % against 24.9 %: a documented deviation, see the
+//! `chatter_updating::karandikar` module docs and `examples/karandikar_point_d.py`), so only
+//! D's P_s is held, and its reduction is held below 5 % (what the deviation says).
 //! 300 paths (the example uses 2000): a few seconds.
 
 #![allow(clippy::unwrap_used)]
@@ -23,7 +24,9 @@ fn table_2_candidates_match_the_paper() {
             t.label, r.p_stable, t.paper_p_stable, r.reduction_percent, t.paper_reduction_percent
         );
         assert!((r.p_stable - t.paper_p_stable).abs() <= 0.1, "{t:?}: {r:?}");
-        if t.label != "D" {
+        if t.label == "D" {
+            assert!(r.reduction_percent < 5.0, "{t:?}: {r:?}");
+        } else {
             assert!(
                 (r.reduction_percent - t.paper_reduction_percent).abs() <= 5.0,
                 "{t:?}: {r:?}"
