@@ -246,12 +246,11 @@ def _simulate():
 
 
 def _oma():
-    # a stable turning record (made before the interrupt is armed) identified over 200
-    # segments: several seconds uninterrupted
-    sim = chatter.simulate(TURNING_MODEL, 7000.0, 0.1, duration_s=20.0, sample_rate_hz=20000.0,
+    # a stable turning record of 10 s at 20 kHz, made before the interrupt is armed; its OMA
+    # takes several seconds uninterrupted
+    sim = chatter.simulate(TURNING_MODEL, 7000.0, 0.1, duration_s=10.0, sample_rate_hz=20000.0,
                            seed=1)
-    return lambda: chatter.oma(sim["data"][:2], sim["sample_rate_hz"], speed_rpm=7000.0,
-                               segments=200)
+    return lambda: chatter.oma(sim["data"][:2], sim["sample_rate_hz"], speed_rpm=7000.0)
 
 
 def _interrupt_once_started():
