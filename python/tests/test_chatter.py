@@ -253,13 +253,15 @@ def _oma():
     return lambda: chatter.oma(sim["data"][:2], sim["sample_rate_hz"], speed_rpm=7000.0)
 
 
-def _interrupt_once_started():
+def _interrupt_once_started(done):
     """A thread that raises Ctrl-C in the main thread as soon as a chatter call's worker runs,
     so that the interrupt lands inside the call whatever the machine's load (a timer can fire
-    before the call starts or after it ends)."""
+    before the call starts or after it ends); it gives up once `done` is set."""
 
     def watch():
         while chatter._chatter._running_workers() == 0:
+            if done.is_set():
+                return
             time.sleep(0.001)
         _thread.interrupt_main()
 
@@ -276,10 +278,15 @@ def test_a_long_call_is_cancelled_inside_the_library_by_ctrl_c(make):
     cancel would keep its worker busy for seconds to minutes)."""
     call = make()
     assert chatter._chatter._running_workers() == 0
-    watcher = _interrupt_once_started()
-    with pytest.raises(KeyboardInterrupt):
-        call()
-    watcher.join()
+    done = threading.Event()
+    watcher = _interrupt_once_started(done)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        # a watcher still waiting must not interrupt a later test
+        done.set()
+        watcher.join()
     assert chatter._chatter._running_workers() == 0
 
 
