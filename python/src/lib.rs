@@ -544,8 +544,10 @@ fn simulate<'py>(
     s.random_force_rms_n = random_force_n;
     s.harmonic_force_n = harmonic_force_n;
     s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
-    let sim = run_detached(py, move |_| chatter_dynamics::simulate::simulate(&m, &s))?
-        .map_err(value_error)?;
+    let sim = run_detached(py, move |observer| {
+        chatter_dynamics::simulate::simulate_with_observer(&m, &s, observer)
+    })?
+    .map_err(value_error)?;
     let names: Vec<String> = sim.channels.iter().map(|c| c.name.clone()).collect();
     let rows: Vec<Vec<f64>> = sim.channels.into_iter().map(|c| c.data).collect();
     let d = PyDict::new(py);
@@ -583,8 +585,8 @@ fn detect<'py>(
     let signals = signals_of(data, sample_rate_hz, names)?;
     let mut options = DetectionOptions::new(speed_rpm / 60.0);
     options.once_per_rev_channel = once_per_rev_channel;
-    let det = run_detached(py, move |_| {
-        chatter_oma::detection::detect(&signals, &options)
+    let det = run_detached(py, move |observer| {
+        chatter_oma::detection::detect_with_observer(&signals, &options, observer)
     })?
     .map_err(value_error)?;
     let d = PyDict::new(py);
@@ -616,8 +618,10 @@ fn oma<'py>(
             fundamental_hz: s / 60.0,
         };
     }
-    let id = run_detached(py, move |_| chatter_oma::identify(&signals, &options))?
-        .map_err(value_error)?;
+    let id = run_detached(py, move |observer| {
+        chatter_oma::identify_with_observer(&signals, &options, observer)
+    })?
+    .map_err(value_error)?;
     let e = &id.estimate;
     let d = PyDict::new(py);
     d.set_item("frequency_hz", e.frequency_hz)?;
@@ -676,8 +680,8 @@ fn oma_observations<'py>(
         },
         allow_chatter,
     };
-    let (result, _) = run_detached(py, move |_| {
-        chatter_jobs::oma::identify_observations(&o, m.as_ref(), &request)
+    let (result, _) = run_detached(py, move |observer| {
+        chatter_jobs::oma::identify_observations(&o, m.as_ref(), &request, observer)
     })?
     .map_err(value_error)?;
     let poles = &result.poles;
@@ -999,8 +1003,8 @@ fn run_campaign<'py>(
         observations,
         seed,
     };
-    let result = run_detached(py, move |_| {
-        let row = campaign::run_campaign(&c, &options);
+    let result = run_detached(py, move |observer| {
+        let row = campaign::run_campaign(&c, &options, observer);
         (c, row)
     })?;
     let d = PyDict::new(py);
@@ -1036,7 +1040,8 @@ fn batch(
     let campaigns = campaign::read_manifest(&manifest).map_err(value_error)?;
     run_detached(py, move |observer| {
         campaign::run_batch(&campaigns, &options, observer)
-    })
+    })?
+    .map_err(value_error)
 }
 
 /// The batch table of table lines in order (header first).

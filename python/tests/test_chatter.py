@@ -5,6 +5,7 @@ import _thread
 import csv
 import json
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -231,26 +232,61 @@ def _update():
 
 
 def _diagnose():
-    # the data are made before the timer starts, so that the interrupt lands in the diagnosis
+    # the data are made before the interrupt is armed, so that it lands in the diagnosis
     model, observations = chatter.synthetic_campaign("process_damping", 2.0, seed=5, cuts=8,
                                                      pole_speeds=0)
     return lambda: chatter.diagnose(model, observations, seed=2, samples=4000,
                                     validation="off", pointwise=False)
 
 
-@pytest.mark.parametrize("make", [_lobes, _update, _diagnose], ids=["lobes", "update", "diagnose"])
+def _simulate():
+    # 60 s of turning at 20 kHz: several seconds uninterrupted
+    return lambda: chatter.simulate(TURNING_MODEL, 7000.0, 0.1, duration_s=60.0,
+                                    sample_rate_hz=20000.0, seed=1)
+
+
+def _oma():
+    # a stable turning record of 10 s at 20 kHz, made before the interrupt is armed; its OMA
+    # takes several seconds uninterrupted
+    sim = chatter.simulate(TURNING_MODEL, 7000.0, 0.1, duration_s=10.0, sample_rate_hz=20000.0,
+                           seed=1)
+    return lambda: chatter.oma(sim["data"][:2], sim["sample_rate_hz"], speed_rpm=7000.0)
+
+
+def _interrupt_once_started(done):
+    """A thread that raises Ctrl-C in the main thread as soon as a chatter call's worker runs,
+    so that the interrupt lands inside the call whatever the machine's load (a timer can fire
+    before the call starts or after it ends); it gives up once `done` is set."""
+
+    def watch():
+        while chatter._chatter._running_workers() == 0:
+            if done.is_set():
+                return
+            time.sleep(0.001)
+        _thread.interrupt_main()
+
+    thread = threading.Thread(target=watch, daemon=True)
+    thread.start()
+    return thread
+
+
+@pytest.mark.parametrize("make", [_lobes, _update, _diagnose, _simulate, _oma],
+                         ids=["lobes", "update", "diagnose", "simulate", "oma"])
 def test_a_long_call_is_cancelled_inside_the_library_by_ctrl_c(make):
     """Ctrl-C raises KeyboardInterrupt, and the library stopped: the call waits for its worker
     after asking it to cancel, so no worker is left running (a library that did not poll the
     cancel would keep its worker busy for seconds to minutes)."""
     call = make()
-    timer = threading.Timer(0.5, _thread.interrupt_main)
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        # a few calls in a row, so that a timer delayed on a loaded machine still lands inside one
-        for _ in range(10):
+    assert chatter._chatter._running_workers() == 0
+    done = threading.Event()
+    watcher = _interrupt_once_started(done)
+    try:
+        with pytest.raises(KeyboardInterrupt):
             call()
-    timer.join()
+    finally:
+        # a watcher still waiting must not interrupt a later test
+        done.set()
+        watcher.join()
     assert chatter._chatter._running_workers() == 0
 
 

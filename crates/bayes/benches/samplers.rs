@@ -39,8 +39,15 @@ fn bench(c: &mut Criterion) {
     });
     group.bench_function("rejection_20000_then_amcmc_4000", |b| {
         b.iter(|| {
-            let start = rejection_sample(&prior, &like, 20_000, LikelihoodBound::Known(0.0), 1)
-                .expect("survivors");
+            let start = rejection_sample(
+                &prior,
+                &like,
+                20_000,
+                LikelihoodBound::Known(0.0),
+                1,
+                &Silent,
+            )
+            .expect("survivors");
             adaptive_mcmc(
                 &prior,
                 &like,

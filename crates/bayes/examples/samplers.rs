@@ -83,7 +83,14 @@ fn main() -> Result<(), chatter_bayes::BayesError> {
     report("iTMCMC, GP surrogate (64)", &run.samples);
     println!("{:<28} ln p(D) = {:.3}", "", run.log_evidence);
 
-    let kept = rejection_sample(&prior, &exact, 20_000, LikelihoodBound::Known(0.0), 1)?;
+    let kept = rejection_sample(
+        &prior,
+        &exact,
+        20_000,
+        LikelihoodBound::Known(0.0),
+        1,
+        &Silent,
+    )?;
     println!(
         "rejection: {} of 20000 prior samples kept, ln p(D) = {:.3} (prior Monte Carlo)",
         kept.accepted.len(),

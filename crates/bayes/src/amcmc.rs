@@ -190,6 +190,7 @@ pub fn adaptive_mcmc<P: Prior, L: LogLikelihood>(
     observer: &dyn Observer,
 ) -> Result<AmcmcResult> {
     let options = options.validated()?;
+    chatter_progress::check(observer)?;
     let d = prior.dimension();
     if retained.len() < 2 {
         return Err(BayesError::InvalidInput {

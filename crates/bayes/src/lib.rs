@@ -29,7 +29,7 @@
 //! let prior = IndependentPrior::new(vec![Marginal::Normal { mean: 0.0, sd: 1.0 }])?;
 //! let sd: f64 = 0.5;
 //! let like = |t: &[f64]| -0.5 * ((t[0] - 1.0) / sd).powi(2) - (sd * (2.0 * std::f64::consts::PI).sqrt()).ln();
-//! let kept = rejection_sample(&prior, &like, 2000, LikelihoodBound::Estimated, 1)?;
+//! let kept = rejection_sample(&prior, &like, 2000, LikelihoodBound::Estimated, 1, &Silent)?;
 //! let opts = AmcmcOptions { unique_samples: 2000, ..Default::default() };
 //! let chain = adaptive_mcmc(&prior, &like, &kept.accepted, &opts, &Silent)?;
 //! assert!((chain.samples.mean()[0] - 0.8).abs() < 0.1);

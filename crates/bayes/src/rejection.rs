@@ -12,12 +12,14 @@
 //!
 //! Each sample draws its uniform (and, in [`rejection_sample`], its prior draw) from its own random
 //! stream seeded by (seed, index), and likelihoods are evaluated in parallel with rayon, so the
-//! result does not depend on the number of threads.
+//! result does not depend on the number of threads. The observer is polled before every
+//! likelihood evaluation; a cancelled run returns [`BayesError::Cancelled`].
 
 use crate::error::{BayesError, Result};
 use crate::prior::Prior;
 use crate::special::log_mean_exp;
 use crate::tmcmc::{LogLikelihood, stream};
+use chatter_progress::Observer;
 use rand::Rng;
 use rayon::prelude::*;
 
@@ -55,12 +57,13 @@ pub struct RejectionResult {
 }
 
 /// Keep each of `samples` with probability L / L_max (004 Section 4: discard with probability
-/// 1 - P(a | u)). `seed` fixes the uniforms.
+/// 1 - P(a | u)). `seed` fixes the uniforms; `observer` can cancel the evaluations.
 pub fn rejection_filter<L: LogLikelihood>(
     samples: &[Vec<f64>],
     likelihood: &L,
     bound: LikelihoodBound,
     seed: u64,
+    observer: &dyn Observer,
 ) -> Result<RejectionResult> {
     if samples.is_empty() {
         return Err(BayesError::InvalidInput {
@@ -70,8 +73,14 @@ pub fn rejection_filter<L: LogLikelihood>(
     }
     let ln_l: Vec<f64> = samples
         .par_iter()
-        .map(|u| likelihood.ln_likelihood(u))
+        .map(|u| {
+            if observer.cancelled() {
+                return f64::NEG_INFINITY;
+            }
+            likelihood.ln_likelihood(u)
+        })
         .collect();
+    chatter_progress::check(observer)?;
     if let Some(i) = ln_l.iter().position(|l| l.is_nan()) {
         return Err(BayesError::InvalidInput {
             field: "likelihood",
@@ -140,6 +149,7 @@ pub fn rejection_sample<P: Prior, L: LogLikelihood>(
     draws: usize,
     bound: LikelihoodBound,
     seed: u64,
+    observer: &dyn Observer,
 ) -> Result<RejectionResult> {
     if draws == 0 {
         return Err(BayesError::InvalidInput {
@@ -151,31 +161,35 @@ pub fn rejection_sample<P: Prior, L: LogLikelihood>(
         .into_par_iter()
         .map(|i| prior.sample(&mut stream(seed, PRIOR_STAGE, i)))
         .collect();
-    rejection_filter(&samples, likelihood, bound, seed)
+    rejection_filter(&samples, likelihood, bound, seed, observer)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::prior::{IndependentPrior, Marginal};
+    use chatter_progress::Silent;
 
     #[test]
     fn known_bound_is_checked_and_zero_likelihood_fails() {
         let samples = vec![vec![0.0], vec![1.0]];
         let like = |t: &[f64]| -t[0];
-        assert!(rejection_filter(&samples, &like, LikelihoodBound::Known(-0.5), 1).is_err());
-        let r = rejection_filter(&samples, &like, LikelihoodBound::Known(0.0), 1).unwrap();
+        assert!(
+            rejection_filter(&samples, &like, LikelihoodBound::Known(-0.5), 1, &Silent).is_err()
+        );
+        let r = rejection_filter(&samples, &like, LikelihoodBound::Known(0.0), 1, &Silent).unwrap();
         assert!(r.accepted.iter().all(|u| u.len() == 1));
         let zero = |_: &[f64]| f64::NEG_INFINITY;
-        assert!(rejection_filter(&samples, &zero, LikelihoodBound::Estimated, 1).is_err());
-        assert!(rejection_filter(&[], &like, LikelihoodBound::Estimated, 1).is_err());
+        assert!(rejection_filter(&samples, &zero, LikelihoodBound::Estimated, 1, &Silent).is_err());
+        assert!(rejection_filter(&[], &like, LikelihoodBound::Estimated, 1, &Silent).is_err());
     }
 
     #[test]
     fn flat_likelihood_keeps_everything() {
         let prior = IndependentPrior::new(vec![Marginal::Normal { mean: 0.0, sd: 1.0 }]).unwrap();
         let flat = |_: &[f64]| -3.0;
-        let r = rejection_sample(&prior, &flat, 100, LikelihoodBound::Estimated, 4).unwrap();
+        let r =
+            rejection_sample(&prior, &flat, 100, LikelihoodBound::Estimated, 4, &Silent).unwrap();
         assert_eq!(r.accepted.len(), 100);
         assert!((r.log_mean_likelihood + 3.0).abs() < 1e-12);
     }

@@ -384,6 +384,7 @@ impl<P: Prior, L: LogLikelihood> Chains<'_, P, L> {
 /// these moves spread them over the posterior again (for a posterior predictive check, say).
 /// The log-evidence is the run's; samples, their log-likelihoods, counts, and one beta = 1 and
 /// acceptance entry per round are updated. Seeded by `seed` (stages numbered after the run's).
+/// `observer` is polled before every move; a cancelled call returns [`BayesError::Cancelled`].
 pub fn rejuvenate<P: Prior, L: LogLikelihood>(
     prior: &P,
     likelihood: &L,
@@ -391,6 +392,7 @@ pub fn rejuvenate<P: Prior, L: LogLikelihood>(
     rounds: usize,
     steps: usize,
     seed: u64,
+    observer: &dyn Observer,
 ) -> Result<TmcmcResult> {
     let mut theta: Vec<Vec<f64>> = run.samples.samples().to_vec();
     let n = theta.len();
@@ -414,7 +416,7 @@ pub fn rejuvenate<P: Prior, L: LogLikelihood>(
             stage: run.betas.len() + round,
             evaluations: &evaluations,
             failures: &failures,
-            observer: &chatter_progress::Silent,
+            observer,
         };
         let moved: Vec<(Vec<f64>, f64, usize)> = theta
             .par_iter()
@@ -422,6 +424,7 @@ pub fn rejuvenate<P: Prior, L: LogLikelihood>(
             .enumerate()
             .map(|(chain, (x, &lx))| chains.run(chain, x.clone(), lx))
             .collect();
+        chatter_progress::check(observer)?;
         let acc = moved.iter().map(|m| m.2).sum::<usize>() as f64 / (n * steps.max(1)) as f64;
         theta = moved.iter().map(|m| m.0.clone()).collect();
         ln_l = moved.iter().map(|m| m.1).collect();

@@ -94,7 +94,7 @@ fn samplers_take_the_correlated_prior() {
         - 0.5 * (r.transpose() * total.try_inverse().unwrap() * r)[(0, 0)];
     // rejection sampling: independent posterior draws
     let bound = LikelihoodBound::Known(-(2.0 * PI * s * s).ln());
-    let kept = rejection_sample(&p, &like, 40_000, bound, 11).unwrap();
+    let kept = rejection_sample(&p, &like, 40_000, bound, 11, &Silent).unwrap();
     let n = kept.accepted.len() as f64;
     let mean: Vec<f64> = (0..2)
         .map(|j| kept.accepted.iter().map(|u| u[j]).sum::<f64>() / n)

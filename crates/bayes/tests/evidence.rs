@@ -289,7 +289,7 @@ fn rejuvenation_spreads_a_small_population_over_the_posterior() {
             ..Default::default()
         };
         let run = tmcmc(&prior, &like, &options, &Silent).unwrap();
-        let polished = rejuvenate(&prior, &like, &run, 10, 3, seed).unwrap();
+        let polished = rejuvenate(&prior, &like, &run, 10, 3, seed, &Silent).unwrap();
         let (before, after) = (distinct(&run), distinct(&polished));
         let m = polished.samples.mean()[0];
         let v = polished.samples.covariance()[(0, 0)];

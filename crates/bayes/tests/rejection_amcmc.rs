@@ -29,7 +29,7 @@ fn rejection_sampling_conjugate_gaussian() {
     let (prior, like) = conjugate();
     // the likelihood is a normalized density in Y: its largest value is 1 / (S sqrt(2 pi))
     let bound = LikelihoodBound::Known(-(S * (2.0 * PI).sqrt()).ln());
-    let r = rejection_sample(&prior, &like, 20_000, bound, 3).unwrap();
+    let r = rejection_sample(&prior, &like, 20_000, bound, 3, &Silent).unwrap();
     // acceptance Z / L_max = sqrt(S^2 / (1 + S^2)) exp(-Y^2 / (2 (1 + S^2))) = 0.251
     let expected_rate = (S * S / (1.0 + S * S)).sqrt() * (-Y * Y / (2.0 * (1.0 + S * S))).exp();
     let n = r.accepted.len() as f64;
@@ -76,7 +76,8 @@ fn effective_size(run: &AmcmcResult) -> f64 {
 #[test]
 fn amcmc_conjugate_gaussian() {
     let (prior, like) = conjugate();
-    let start = rejection_sample(&prior, &like, 200, LikelihoodBound::Estimated, 1).unwrap();
+    let start =
+        rejection_sample(&prior, &like, 200, LikelihoodBound::Estimated, 1, &Silent).unwrap();
     for seed in 0..3 {
         let opts = AmcmcOptions {
             unique_samples: 4000,
@@ -122,7 +123,15 @@ fn amcmc_correlated_gaussian_2d() {
         let b = (t[1] - MU[1]) / SD[1];
         -0.5 * (a * a - 2.0 * RHO * a * b + b * b) / (1.0 - RHO * RHO)
     };
-    let start = rejection_sample(&prior, &like, 20_000, LikelihoodBound::Known(0.0), 5).unwrap();
+    let start = rejection_sample(
+        &prior,
+        &like,
+        20_000,
+        LikelihoodBound::Known(0.0),
+        5,
+        &Silent,
+    )
+    .unwrap();
     assert!(
         start.accepted.len() >= 10,
         "{} survivors",
@@ -175,7 +184,15 @@ fn same_seed_same_result_for_any_thread_count() {
         .build()
         .unwrap();
     let run = |seed| {
-        let r = rejection_sample(&prior, &like, 500, LikelihoodBound::Estimated, seed).unwrap();
+        let r = rejection_sample(
+            &prior,
+            &like,
+            500,
+            LikelihoodBound::Estimated,
+            seed,
+            &Silent,
+        )
+        .unwrap();
         let opts = AmcmcOptions {
             unique_samples: 300,
             chains: 3,

@@ -37,7 +37,7 @@ pub fn run(args: &BatchArgs, quiet: bool) -> Result<()> {
     crate::validate::count("--samples", args.samples, 40, 100_000, "samples per class")?;
     crate::validate::count("--paths", args.paths, 10, 100_000, "sampled boundaries")?;
     let bar = Bar::new(campaigns.len() as u64, "campaigns", quiet);
-    let table = run_batch(&campaigns, &options, &bar);
+    let table = run_batch(&campaigns, &options, &bar).map_err(crate::job_error)?;
     bar.finish();
     let failed = table.lines().skip(1).filter(|l| !l.ends_with(',')).count();
     if failed > 0 {

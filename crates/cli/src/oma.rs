@@ -115,8 +115,13 @@ pub fn run(args: &OmaArgs) -> Result<()> {
         interference: crate::detect::interference(&args.interference_hz)?,
         allow_chatter: args.allow_chatter,
     };
-    let (result, analyses) = identify_observations(&observations, model.as_ref(), &request)
-        .with_context(|| args.observations.display().to_string())?;
+    let (result, analyses) = identify_observations(
+        &observations,
+        model.as_ref(),
+        &request,
+        &chatter_progress::Silent,
+    )
+    .with_context(|| args.observations.display().to_string())?;
     if let Some(plot) = &args.plot {
         let count = observations.signals.len();
         for (i, (record, analysis)) in observations.signals.iter().zip(&analyses).enumerate() {

@@ -47,6 +47,9 @@ pub enum DynamicsError {
         /// The validation error.
         error: Box<DynamicsError>,
     },
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 impl DynamicsError {

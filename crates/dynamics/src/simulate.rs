@@ -210,7 +210,8 @@ pub fn internal_step(f_max_hz: f64, tau_s: f64, min_steps: usize) -> (f64, usize
     (tau_s / steps as f64, steps)
 }
 
-/// Simulate a cut, reporting progress to `observer`.
+/// Simulate a cut, reporting progress to `observer`, which is polled every hundredth of the
+/// record ([`DynamicsError::Cancelled`]).
 pub fn simulate_with_observer(
     model: &ModalModel,
     settings: &SimulationSettings,
@@ -434,6 +435,7 @@ pub fn simulate_with_observer(
             ));
         }
         if step % report_every == 0 {
+            chatter_progress::check(observer)?;
             observer.fraction_done(step as f64 / total_steps as f64);
         }
     }
@@ -525,5 +527,14 @@ mod tests {
         ] {
             assert!(simulate(&model, &s).is_err(), "{s:?}");
         }
+    }
+
+    #[test]
+    fn a_cancelled_simulation_stops_at_its_first_step() {
+        // 100 s of milling would take about a minute
+        let model = examples::schmitz_2023_milling();
+        let settings = SimulationSettings::new(7000.0, 1e-3, 100.0, 1e4, 1);
+        let r = simulate_with_observer(&model, &settings, &chatter_progress::AlreadyCancelled);
+        assert!(matches!(r, Err(DynamicsError::Cancelled(_))), "{r:?}");
     }
 }

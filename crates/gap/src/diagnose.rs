@@ -398,12 +398,13 @@ pub(crate) fn fit<'a>(
 /// [`fit`]'s run of the named class moved on by [`rejuvenate`]: the small population leaves
 /// copies of few points after the last resampling, and the predictive check and the reported
 /// parameters need the posterior's spread (`DiagnoseOptions::polish_rounds` rounds of
-/// `steps + burn_in` steps per sample). The evidence stays the run's.
+/// `steps + burn_in` steps per sample). The evidence stays the run's; `observer` may cancel it.
 pub(crate) fn polish(
     fitted: &mut Fitted,
     data: &Dataset,
     options: &DiagnoseOptions,
     seed: u64,
+    observer: &dyn Observer,
 ) -> Result<()> {
     if options.polish_rounds == 0 {
         return Ok(());
@@ -417,10 +418,14 @@ pub(crate) fn polish(
         options.polish_rounds,
         options.steps + options.burn_in,
         seed,
+        observer,
     )
-    .map_err(|source| GapError::Sampler {
-        class: fitted.model.class.name(),
-        source,
+    .map_err(|source| match source {
+        chatter_bayes::BayesError::Cancelled(c) => GapError::Cancelled(c),
+        source => GapError::Sampler {
+            class: fitted.model.class.name(),
+            source,
+        },
     })?;
     let (evaluations, failures) = count.get();
     fitted.run = run;
@@ -630,7 +635,7 @@ pub fn diagnose(
         _ => most_probable,
     };
     let polish_seed = class_seed(options.seed, fitted[best].model.class, usize::MAX);
-    polish(&mut fitted[best], &data, &options, polish_seed)?;
+    polish(&mut fitted[best], &data, &options, polish_seed, observer)?;
     let predictions = posterior_predictions(&fitted[best], &data);
     let check = predictive_check(
         &predictions,

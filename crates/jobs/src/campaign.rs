@@ -164,13 +164,14 @@ pub fn error_line(name: &str, error: &str) -> String {
     format!("{},,,,,,,{}", quote(name), quote(error))
 }
 
-/// Diagnose one campaign already read and plan its next test.
+/// Diagnose one campaign already read and plan its next test; `observer` may cancel both.
 pub fn campaign_row(
     name: &str,
     model: &ModalModel,
     observations: &Observations,
     seed: u64,
     options: &CampaignOptions,
+    observer: &dyn Observer,
 ) -> Result<CampaignRow> {
     let request = DiagnoseRequest {
         seed,
@@ -178,7 +179,7 @@ pub fn campaign_row(
         validation: options.validation,
         pointwise: false,
     };
-    let diagnosis = diagnose(model, observations, &request, &chatter_progress::Silent)?;
+    let diagnosis = diagnose(model, observations, &request, observer)?;
     let mut speeds = observations.speeds_rpm();
     speeds.sort_by(f64::total_cmp);
     speeds.dedup();
@@ -201,7 +202,7 @@ pub fn campaign_row(
         diagnosis.diagnosed_model(),
         observations,
         &plan_request,
-        &chatter_progress::Silent,
+        observer,
     )?;
     let next = outcome.next_cut.filter(|_| !outcome.stop);
     Ok(CampaignRow {
@@ -215,8 +216,12 @@ pub fn campaign_row(
     })
 }
 
-/// Read a campaign's files and reduce it to a row.
-pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<CampaignRow> {
+/// Read a campaign's files and reduce it to a row; `observer` may cancel it.
+pub fn run_campaign(
+    campaign: &Campaign,
+    options: &CampaignOptions,
+    observer: &dyn Observer,
+) -> Result<CampaignRow> {
     let model = ModalModel::from_path(&campaign.model)?;
     let observations = Observations::from_path(&campaign.observations)?;
     campaign_row(
@@ -225,13 +230,18 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         &observations,
         campaign.seed,
         options,
+        observer,
     )
 }
 
 /// The table line of a campaign: its row, or its error (a failed campaign does not stop the
-/// batch).
-pub fn campaign_line(campaign: &Campaign, options: &CampaignOptions) -> String {
-    match run_campaign(campaign, options) {
+/// batch); `observer` may cancel it.
+pub fn campaign_line(
+    campaign: &Campaign,
+    options: &CampaignOptions,
+    observer: &dyn Observer,
+) -> String {
+    match run_campaign(campaign, options, observer) {
         Ok(row) => row.csv_line(),
         Err(e) => error_line(&campaign.name, &e.to_string()),
     }
@@ -239,23 +249,29 @@ pub fn campaign_line(campaign: &Campaign, options: &CampaignOptions) -> String {
 
 /// Every campaign in parallel (rayon), the table in manifest order: the header, then one line
 /// per campaign. Each campaign is seeded by its own line, so the table does not depend on the
-/// number of threads; `observer` hears of each finished campaign.
+/// number of threads; `observer` hears of each finished campaign. A cancel (the observer's)
+/// stops the campaigns under way and skips the others: the batch is then
+/// [`JobError::Cancelled`], not a table of failed lines.
 pub fn run_batch(
     campaigns: &[Campaign],
     options: &CampaignOptions,
     observer: &dyn Observer,
-) -> String {
+) -> Result<String> {
     let finished = std::sync::atomic::AtomicUsize::new(0);
     let lines: Vec<String> = campaigns
         .par_iter()
         .map(|c| {
-            let line = campaign_line(c, options);
+            if observer.cancelled() {
+                return String::new();
+            }
+            let line = campaign_line(c, options, observer);
             let k = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             observer.steps_done(k, campaigns.len());
             line
         })
         .collect();
-    table(&lines)
+    chatter_progress::check(observer)?;
+    Ok(table(&lines))
 }
 
 /// The batch table of lines in order.
@@ -301,11 +317,43 @@ mod tests {
             observations: "/nonexistent/o.json".into(),
             seed: 0,
         };
-        let line = campaign_line(&c, &CampaignOptions::default());
+        let line = campaign_line(&c, &CampaignOptions::default(), &chatter_progress::Silent);
         assert!(line.starts_with("\"x,1\",,,,,,,"), "{line}");
         assert!(line.contains("m.json"), "{line}");
         let t = table(&[line]);
         assert_eq!(t.lines().next(), Some(TABLE_HEADER));
         assert_eq!(t.lines().count(), 2);
+    }
+
+    #[test]
+    fn a_cancelled_campaign_and_batch_stop() {
+        let nominal = chatter_gap::nominal_milling().unwrap();
+        let scenario = chatter_gap::Scenario::new(chatter_gap::HiddenEffect::ParameterError, 1);
+        let observations = chatter_gap::synthesize(&nominal, &scenario).unwrap();
+        let options = CampaignOptions::default();
+        let cancelled = &chatter_progress::AlreadyCancelled;
+        let row = campaign_row("a", &nominal, &observations, 1, &options, cancelled);
+        assert!(
+            matches!(
+                row,
+                Err(JobError::Gap(chatter_gap::GapError::Cancelled(_)) | JobError::Cancelled(_))
+            ),
+            "{row:?}"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let (model, obs) = (dir.path().join("m.json"), dir.path().join("o.json"));
+        let model_json = serde_json::to_string(&chatter_dynamics::ModelFile::from_model(&nominal));
+        std::fs::write(&model, model_json.unwrap()).unwrap();
+        std::fs::write(&obs, observations.to_json_string()).unwrap();
+        let campaigns: Vec<Campaign> = (0..50)
+            .map(|seed| Campaign {
+                name: format!("c{seed}"),
+                model: model.clone(),
+                observations: obs.clone(),
+                seed,
+            })
+            .collect();
+        let batch = run_batch(&campaigns, &options, cancelled);
+        assert!(matches!(batch, Err(JobError::Cancelled(_))), "{batch:?}");
     }
 }

@@ -39,6 +39,9 @@ pub enum JobError {
     /// Operational modal analysis and chatter detection.
     #[error(transparent)]
     Oma(#[from] chatter_oma::OmaError),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
     /// A signal record of an observations file cannot be used.
     #[error("{record}: {message}")]
     Record {

@@ -17,10 +17,14 @@
 
 use crate::error::{JobError, Result};
 use chatter_dynamics::{ModalModel, Observations, Operation, PoleObservation, SignalRecord};
-use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
+use chatter_oma::OmaError;
+use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect_with_observer};
 use chatter_oma::interference::{Interference, LOW_HARMONICS};
 use chatter_oma::signals::Signals;
-use chatter_oma::{Decimation, Harmonics, Identification, IdentifyOptions, Lifting, identify};
+use chatter_oma::{
+    Decimation, Harmonics, Identification, IdentifyOptions, Lifting, identify_with_observer,
+};
+use chatter_progress::Observer;
 
 /// Overrides of the identification and the chatter check; the default is the automatic choice
 /// of every setting (what `chatter oma` does without options).
@@ -123,12 +127,13 @@ pub fn interference_note(interference: &Interference, d: &Detection) -> String {
 }
 
 /// Identify record `i` (see the module documentation); `model` chooses lifting for milling and
-/// checks the channels.
+/// checks the channels; `observer` may cancel the detection and the identification.
 pub fn analyse_record(
     i: usize,
     record: &SignalRecord,
     model: Option<&ModalModel>,
     request: &OmaRequest,
+    observer: &dyn Observer,
 ) -> Result<RecordAnalysis> {
     let name = format!("signals[{i}]");
     let mut signals = read_record(i, record)?;
@@ -150,7 +155,7 @@ pub fn analyse_record(
     }
     let mut detection_options = DetectionOptions::new(1.0 / revolution_s);
     detection_options.interference = request.interference.clone();
-    let detection = detect(&signals, &detection_options)?;
+    let detection = detect_with_observer(&signals, &detection_options, observer)?;
     let interference = interference_note(&detection_options.interference, &detection);
     let chatter_hz = match (detection.verdict, request.allow_chatter) {
         (Verdict::Stable, _) => None,
@@ -201,7 +206,7 @@ pub fn analyse_record(
     if let Some(n) = request.decimation {
         options.decimation = Decimation::Factor(n);
     }
-    let identification = identify(&signals, &options)?;
+    let identification = identify_with_observer(&signals, &options, observer)?;
     Ok(RecordAnalysis {
         identification,
         signals,
@@ -270,11 +275,13 @@ pub fn pole_observation(record: &SignalRecord, a: &RecordAnalysis) -> PoleObserv
 
 /// Every record of `observations` identified: the observations with the input's `cuts` and one
 /// `poles` entry per signal (ready for the updating commands), and each record's analysis. The
-/// first record that fails is the error, named `signals[i] (file)`.
+/// first record that fails is the error, named `signals[i] (file)`; a cancel (`observer`'s) is
+/// [`JobError::Cancelled`].
 pub fn identify_observations(
     observations: &Observations,
     model: Option<&ModalModel>,
     request: &OmaRequest,
+    observer: &dyn Observer,
 ) -> Result<(Observations, Vec<RecordAnalysis>)> {
     if observations.signals.is_empty() {
         return Err(JobError::Invalid {
@@ -286,13 +293,17 @@ pub fn identify_observations(
     let mut poles = Vec::with_capacity(observations.signals.len());
     let mut analyses = Vec::with_capacity(observations.signals.len());
     for (i, record) in observations.signals.iter().enumerate() {
-        let analysis = analyse_record(i, record, model, request).map_err(|e| JobError::Record {
-            record: format!("signals[{i}] ({})", record.file.display()),
-            message: match e {
-                JobError::Record { message, .. } => message,
-                e => e.to_string(),
-            },
-        })?;
+        let analysis =
+            analyse_record(i, record, model, request, observer).map_err(|e| match e {
+                JobError::Oma(OmaError::Cancelled(c)) => JobError::Cancelled(c),
+                e => JobError::Record {
+                    record: format!("signals[{i}] ({})", record.file.display()),
+                    message: match e {
+                        JobError::Record { message, .. } => message,
+                        e => e.to_string(),
+                    },
+                },
+            })?;
         poles.push(pole_observation(record, &analysis));
         analyses.push(analysis);
     }

@@ -129,6 +129,7 @@ use crate::interference::{
 };
 use crate::signals::Signals;
 use crate::spectrum::{Spectrum, refine_peak_hz, segment_densities};
+use chatter_progress::{Observer, Silent};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -431,6 +432,18 @@ fn invalid(field: &'static str, message: String) -> OmaError {
 
 /// Decide whether `signals` chatter (see the [module documentation](self)).
 pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection> {
+    detect_with_observer(signals, options, &Silent)
+}
+
+/// [`detect`], polling `observer` between its stages (the spectrum, the fundamental, the
+/// windows) and before every short segment of the line variation: a cancelled call returns
+/// [`OmaError::Cancelled`].
+pub fn detect_with_observer(
+    signals: &Signals,
+    options: &DetectionOptions,
+    observer: &dyn Observer,
+) -> Result<Detection> {
+    chatter_progress::check(observer)?;
     let fs = signals.sample_rate_hz;
     let nyquist = fs / 2.0;
     let f0_lowest = options.fundamental.lowest_hz();
@@ -536,6 +549,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
         }
     }
     let psd = mean_density(&segment_psd);
+    chatter_progress::check(observer)?;
     let lo = options.min_frequency_hz.unwrap_or(f0_lowest / 2.0);
     let hi = options.max_frequency_hz.unwrap_or(0.45 * fs).min(nyquist);
     if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo + 8.0 * df) {
@@ -603,6 +617,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
                 .fundamental_hz
         }
     };
+    chatter_progress::check(observer)?;
     let comb = interference_search(Some(f0));
     let comb_lines: &[f64] = comb.as_ref().map_or(&[], |c| &c.lines_hz);
     let synchronous_bins: Vec<bool> = (0..psd.len())
@@ -631,22 +646,25 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
     let line_to_floor_db = 10.0 * (psd[peak] / floor.max(tiny)).log10();
     let peak_hz = refine_peak_hz(&psd, peak, df);
     let second_half =
-        |bin: usize| line_variation(&signals.data, &stats, segment, bin, (n / 2, n), 4);
-    let variation = second_half(peak);
+        |bin: usize| line_variation(&signals.data, &stats, segment, bin, (n / 2, n), 4, observer);
+    let variation = second_half(peak)?;
     let margin = variation_margin(variation, options);
+    chatter_progress::check(observer)?;
     let whole = margin >= 0.0 && line_to_floor_db >= MIN_LINE_TO_FLOOR_DB;
     let windowed = judge_windows(
-        &signals.data,
-        &stats,
+        (&signals.data, &stats),
         &segment_psd,
         &synchronous_bins,
         (first, last),
         fs,
         options,
+        observer,
     );
     let flip = match options.teeth {
         Some(teeth) if teeth >= 2 && teeth % 2 == 0 => {
-            flip_lines(&psd, floor, f0, teeth, (first, last), df, second_half).map(|mut f| {
+            // a cancelled variation is NaN here; the observer is checked below
+            let variation = |bin: usize| second_half(bin).unwrap_or(f64::NAN);
+            flip_lines(&psd, floor, f0, teeth, (first, last), df, variation).map(|mut f| {
                 f.variation_margin = options.max_line_variation - f.line_variation;
                 f.runout_margin_db = f.line_to_runout_db.map(|r| r - MIN_FLIP_TO_RUNOUT_DB);
                 f.chatter = f.variation_margin >= 0.0
@@ -657,6 +675,7 @@ pub fn detect(signals: &Signals, options: &DetectionOptions) -> Result<Detection
         }
         _ => None,
     };
+    chatter_progress::check(observer)?;
     let chatter_hz = if whole {
         Some(peak_hz)
     } else {
@@ -904,15 +923,17 @@ fn variation_margin(variation: f64, options: &DetectionOptions) -> f64 {
 /// The record judged window by window (see the [module documentation](self#windows)): windows of
 /// [`WINDOW_SEGMENTS`] spectrum segments every half window, each judged like the whole record
 /// (its own density, floor and strongest non-synchronous line, the line's variation over all of
-/// the window's short segments); `None` when fewer than two windows fit.
+/// the window's short segments); `None` when fewer than two windows fit. `data` and `stats` are
+/// the channels and their standardization; a cancel (`observer`'s) leaves the variations NaN,
+/// and the caller checks the observer.
 fn judge_windows(
-    data: &[Vec<f64>],
-    stats: &[(f64, f64)],
+    (data, stats): (&[Vec<f64>], &[(f64, f64)]),
     segment_psd: &[Vec<f64>],
     synchronous: &[bool],
     (first, last): (usize, usize),
     fs: f64,
     options: &DetectionOptions,
+    observer: &dyn Observer,
 ) -> Option<WindowedEvidence> {
     let bins = segment_psd.first()?.len();
     let segment = 2 * (bins - 1);
@@ -984,7 +1005,10 @@ fn judge_windows(
                     peak,
                     (start, start + WINDOW_SEGMENTS * segment),
                     WINDOW_HOPS_PER_SEGMENT,
+                    observer,
                 )
+                // only a cancel fails, and the caller checks the observer
+                .unwrap_or(f64::NAN)
             });
             let cutting = has_reference && !reference(w);
             Some((
@@ -1079,9 +1103,19 @@ fn judge_windows(
 /// power over the segment's power, so that a cut that deepens or leaves the workpiece changes
 /// neither): segments of half the spectrum's length (so the line, at bin `peak` of the
 /// spectrum, falls at bin peak / 2 of theirs), Hann windowed, starting every
-/// 1 / `hops_per_segment` of their length (a quarter for the whole record) from the record's start, the ones wholly inside `range`; the power is summed over the
-/// three bins around the line and over the channels standardized by `stats` (mean, 1 / standard
-/// deviation).
+/// 1 / `hops_per_segment` of their length (a quarter for the whole record; a power of two, as
+/// the segment is) from the record's start, the ones wholly inside `range`; the power is summed
+/// over the three bins around the line and over the channels standardized by `stats` (mean,
+/// 1 / standard deviation). `observer` is polled once per block of a hop's samples.
+///
+/// # Computation
+/// The segments overlap, so each is cut into `hops_per_segment` blocks of one hop and every
+/// block is transformed once. With the Hann window w_k = 1/2 - 1/4 e^(i theta_k) - 1/4
+/// e^(-i theta_k), theta_k = 2 pi k / L, a segment's windowed DFT at bin b is
+/// 1/2 X_b - 1/4 X_(b-1) - 1/4 X_(b+1) of its plain DFT X, and its windowed energy
+/// sum y^2 w^2 = Re(3/8 E_0 - 1/2 E_1 + 1/8 E_2), E_f the plain DFT of y^2 at bin f. A plain
+/// DFT of a segment is the sum of its blocks' DFTs (block j at offset j h), each turned by
+/// e^(-2 pi i b j h / L).
 fn line_variation(
     data: &[Vec<f64>],
     stats: &[(f64, f64)],
@@ -1089,62 +1123,108 @@ fn line_variation(
     peak: usize,
     (from, to): (usize, usize),
     hops_per_segment: usize,
-) -> f64 {
+    observer: &dyn Observer,
+) -> Result<f64> {
+    use num_complex::Complex64;
+    use std::f64::consts::PI;
     let n = data[0].len();
     let segment = (spectrum_segment / 2).max(16);
     let step = (segment / hops_per_segment).max(1);
+    debug_assert_eq!(segment % step, 0, "the hop divides the segment");
+    let hops = segment / step;
     let centre = (peak as f64 / 2.0).round() as usize;
     if n < segment {
-        return f64::NAN;
+        return Ok(f64::NAN);
     }
     let starts: Vec<usize> = (0..=(n - segment) / step)
         .map(|s| s * step)
         .filter(|s| *s >= from && s + segment <= to)
         .collect();
-    let window: Vec<f64> = (0..segment)
-        .map(|k| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / segment as f64).cos())
+    let (Some(&first), Some(&last)) = (starts.first(), starts.last()) else {
+        return Ok(f64::NAN);
+    };
+    // the windowed bins, and the plain ones they are made of (one more on either side)
+    let windowed = (centre.saturating_sub(1) as i64)..=(centre as i64 + 1);
+    let plain: Vec<i64> = (windowed.start() - 1..=windowed.end() + 1).collect();
+    // e^(-2 pi i b t / L) for a block's offsets t, from one table of the unit circle
+    let circle: Vec<Complex64> = (0..segment)
+        .map(|k| Complex64::from_polar(1.0, -2.0 * PI * k as f64 / segment as f64))
         .collect();
-    let twiddles: Vec<(f64, f64)> = (centre.saturating_sub(1)..=centre + 1)
-        .map(|b| {
-            let w = 2.0 * std::f64::consts::PI * b as f64 / segment as f64;
-            (w.cos(), w.sin())
-        })
+    let turn = |b: i64, t: usize| {
+        let k = (b.rem_euclid(segment as i64) as usize * t) % segment;
+        circle[k]
+    };
+    let kernels: Vec<Vec<Complex64>> = plain
+        .iter()
+        .chain(&[1, 2])
+        .map(|&b| (0..step).map(|t| turn(b, t)).collect())
         .collect();
-    let powers: Vec<f64> = starts
-        .par_iter()
-        .map(|&s| {
-            let mut total = 0.0;
-            let mut energy = 0.0;
-            for (ch, (mean, scale)) in data.iter().zip(stats) {
-                energy += ch[s..s + segment]
-                    .iter()
-                    .zip(&window)
-                    .map(|(v, w)| ((v - mean) * scale * w).powi(2))
-                    .sum::<f64>()
-                    * segment as f64;
-                for &(c, si) in &twiddles {
-                    // DFT at one bin by a rotating phasor
-                    let (mut re, mut im) = (0.0, 0.0);
-                    let (mut cr, mut ci) = (1.0, 0.0);
-                    for (v, w) in ch[s..s + segment].iter().zip(&window) {
-                        let x = (v - mean) * scale * w;
-                        re += x * cr;
-                        im -= x * ci;
-                        let nr = cr * c - ci * si;
-                        ci = cr * si + ci * c;
-                        cr = nr;
+    let bins = plain.len();
+    // per block: each channel's plain DFTs at the plain bins, then the channels' summed E_0,
+    // E_1, E_2 of y^2
+    let (first_block, last_block) = (first / step, last / step + hops - 1);
+    let blocks: Vec<Vec<Complex64>> = (first_block..=last_block)
+        .into_par_iter()
+        .map(|q| {
+            chatter_progress::check(observer)?;
+            let mut sums = vec![Complex64::new(0.0, 0.0); bins * data.len() + 3];
+            for (c, (ch, &(mean, scale))) in data.iter().zip(stats).enumerate() {
+                let mut plain_sums = vec![Complex64::new(0.0, 0.0); bins];
+                let (mut e0, mut e1, mut e2) =
+                    (0.0, Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+                for (t, v) in ch[q * step..(q + 1) * step].iter().enumerate() {
+                    let y = (v - mean) * scale;
+                    for (acc, kernel) in plain_sums.iter_mut().zip(&kernels) {
+                        *acc += kernel[t] * y;
                     }
-                    total += re * re + im * im;
+                    let y2 = y * y;
+                    e0 += y2;
+                    e1 += kernels[bins][t] * y2;
+                    e2 += kernels[bins + 1][t] * y2;
                 }
+                sums[c * bins..(c + 1) * bins].copy_from_slice(&plain_sums);
+                let energy = &mut sums[bins * data.len()..];
+                energy[0] += e0;
+                energy[1] += e1;
+                energy[2] += e2;
             }
-            if energy > 0.0 { total / energy } else { 0.0 }
+            Ok(sums)
+        })
+        .collect::<Result<_>>()?;
+    let powers: Vec<f64> = starts
+        .iter()
+        .map(|&s| {
+            let m0 = s / step - first_block;
+            // a segment's plain DFT at bin b from its blocks
+            let segment_dft = |index: usize, b: i64| {
+                (0..hops)
+                    .map(|j| blocks[m0 + j][index] * turn(b, j * step))
+                    .sum::<Complex64>()
+            };
+            let mut total = 0.0;
+            for c in 0..data.len() {
+                let x: Vec<Complex64> = (0..bins)
+                    .map(|r| segment_dft(c * bins + r, plain[r]))
+                    .collect();
+                total += (1..bins - 1)
+                    .map(|r| (0.5 * x[r] - 0.25 * (x[r - 1] + x[r + 1])).norm_sqr())
+                    .sum::<f64>();
+            }
+            let e = bins * data.len();
+            let energy = 0.375 * segment_dft(e, 0).re - 0.5 * segment_dft(e + 1, 1).re
+                + 0.125 * segment_dft(e + 2, 2).re;
+            if energy > 0.0 {
+                total / (energy * segment as f64)
+            } else {
+                0.0
+            }
         })
         .collect();
     if powers.len() < 2 {
-        return f64::NAN;
+        return Ok(f64::NAN);
     }
     let m = powers.len() as f64;
     let mean = powers.iter().sum::<f64>() / m;
     let var = powers.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (m - 1.0);
-    var.sqrt() / mean
+    Ok(var.sqrt() / mean)
 }

@@ -27,6 +27,9 @@ pub enum OmaError {
     /// A least-squares or eigenvalue problem failed.
     #[error("{0}")]
     Numerical(String),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

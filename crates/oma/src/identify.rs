@@ -90,6 +90,7 @@ use crate::polyreference::polyreference;
 use crate::signals::Signals;
 use crate::stabilization::{StabilityCriteria, StabilizationDiagram};
 use crate::support::{SpectralPeak, SpectralSupport};
+use chatter_progress::{Observer, Silent};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use rand::{Rng, SeedableRng};
@@ -444,7 +445,9 @@ enum Correlations {
 }
 
 /// The sequences poles are fitted to and how.
-struct Prepared {
+struct Prepared<'a> {
+    /// Polled before every correlation and fit.
+    observer: &'a dyn Observer,
     data: Vec<Vec<f64>>,
     interval_s: f64,
     /// Reference channels of `data` (one for LSCE).
@@ -467,9 +470,15 @@ struct Prepared {
     segment_len: usize,
 }
 
-impl Prepared {
+impl<'a> Prepared<'a> {
     /// The sequences of `signals`, decimated by `factor` for LSCE.
-    fn new(signals: &Signals, options: &IdentifyOptions, factor: usize) -> Result<Self> {
+    fn new(
+        signals: &Signals,
+        options: &IdentifyOptions,
+        factor: usize,
+        observer: &'a dyn Observer,
+    ) -> Result<Self> {
+        chatter_progress::check(observer)?;
         let fs = signals.sample_rate_hz;
         let with_segments = |mut p: Self| {
             let total = p.len();
@@ -515,6 +524,7 @@ impl Prepared {
                     options.skip_lags
                 };
                 Ok(with_segments(Self {
+                    observer,
                     data,
                     interval_s: 1.0 / rate,
                     references: vec![options.reference],
@@ -558,6 +568,7 @@ impl Prepared {
                 let support =
                     SpectralSupport::new(&fluctuations, rate, (0.0, 0.5 * rate), &[], None).ok();
                 Ok(with_segments(Self {
+                    observer,
                     data,
                     interval_s: l.period_s,
                     references: (options.reference * nv..(options.reference + 1) * nv).collect(),
@@ -593,6 +604,7 @@ impl Prepared {
     /// Correlations of the window `[start, start + len)`, means removed (per residue class of
     /// samples modulo `classes`), leading lags skipped.
     fn correlations(&self, start: usize, len: usize, lags: usize) -> Result<Correlations> {
+        chatter_progress::check(self.observer)?;
         let classes = self.classes;
         let skip = self.skip_lags;
         let window: Vec<Vec<f64>> = self
@@ -742,6 +754,7 @@ impl Prepared {
     }
 
     fn fit(&self, r: &Correlations, order: usize) -> Result<Vec<Pole>> {
+        chatter_progress::check(self.observer)?;
         match r {
             Correlations::Scalar(r) => lsce(r, 1.0 / self.interval_s, 2 * order, &self.imposed_hz),
             Correlations::Matrix(r) => polyreference(r, self.interval_s, order),
@@ -807,8 +820,18 @@ fn describe(rejected: &[RejectedCluster]) -> String {
 
 /// Identify the dominant pole of `signals` (module documentation, steps 1-5).
 pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identification> {
+    identify_with_observer(signals, options, &Silent)
+}
+
+/// [`identify`], polling `observer` before every correlation and every fit of a model order: a
+/// cancelled call returns [`OmaError::Cancelled`] after at most one fit per thread.
+pub fn identify_with_observer(
+    signals: &Signals,
+    options: &IdentifyOptions,
+    observer: &dyn Observer,
+) -> Result<Identification> {
     validate(signals, options)?;
-    let mut prepared = Prepared::new(signals, options, 1)?;
+    let mut prepared = Prepared::new(signals, options, 1, observer)?;
     let mut pass = prepared.first_pass(options);
     if !prepared.lifted {
         let factor = match options.decimation {
@@ -824,7 +847,7 @@ pub fn identify(signals: &Signals, options: &IdentifyOptions) -> Result<Identifi
             }),
         };
         if factor > 1 {
-            prepared = Prepared::new(signals, options, factor)?;
+            prepared = Prepared::new(signals, options, factor, observer)?;
             pass = prepared.first_pass(options);
         }
     }

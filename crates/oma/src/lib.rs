@@ -62,4 +62,6 @@ pub mod synthetic;
 
 pub use error::{OmaError, Result};
 pub use harmonics::Harmonics;
-pub use identify::{Decimation, Identification, IdentifyOptions, Lifting, identify};
+pub use identify::{
+    Decimation, Identification, IdentifyOptions, Lifting, identify, identify_with_observer,
+};

@@ -93,3 +93,15 @@ pub fn check(observer: &dyn Observer) -> Result<(), Cancelled> {
 pub struct Silent;
 
 impl Observer for Silent {}
+
+/// The observer of a call cancelled before it started: [`Observer::cancelled`] is always true.
+/// What the tests of the polls use: every long call handed it returns its crate's `Cancelled`
+/// error after at most one step.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct AlreadyCancelled;
+
+impl Observer for AlreadyCancelled {
+    fn cancelled(&self) -> bool {
+        true
+    }
+}

@@ -390,20 +390,30 @@ pub(crate) fn in_parallel(
         .collect()
 }
 
-/// |mu| on a speed x depth grid (rows per speed), for contour plots.
+/// |mu| on a speed x depth grid (rows per speed), for contour plots; `observer` hears of each
+/// speed done and is polled before every cell
+/// ([`StabilityError::Cancelled`](crate::StabilityError::Cancelled)).
 pub fn multiplier_grid<S: StabilitySolver + ?Sized>(
     solver: &S,
     model: &ModalModel,
     speeds_rpm: &[f64],
     depths_m: &[f64],
+    observer: &dyn Observer,
 ) -> Result<Vec<Vec<f64>>> {
+    let done = std::sync::atomic::AtomicUsize::new(0);
     speeds_rpm
         .par_iter()
         .map(|&s| {
-            depths_m
+            let row = depths_m
                 .iter()
-                .map(|&b| Ok(solver.dominant_multiplier(model, s, b)?.modulus()))
-                .collect()
+                .map(|&b| {
+                    chatter_progress::check(observer)?;
+                    Ok(solver.dominant_multiplier(model, s, b)?.modulus())
+                })
+                .collect();
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            observer.steps_done(k, speeds_rpm.len());
+            row
         })
         .collect()
 }

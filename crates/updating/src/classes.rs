@@ -96,6 +96,7 @@ pub fn sample_posterior<P: Prior, L: LogLikelihood>(
                 draws,
                 LikelihoodBound::Estimated,
                 options.seed,
+                observer,
             )?;
             if kept.accepted.len() < 2 {
                 return Err(UpdatingError::InvalidInput {
