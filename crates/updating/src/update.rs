@@ -152,7 +152,7 @@ impl PosteriorSummary {
             posterior_mean: result.posterior_mean.clone(),
             prior_bound_pileups: result.prior_bound_pileups.clone(),
             selected_alpha: result.selected_alpha,
-            surrogate: result.surrogate.clone(),
+            surrogate: result.surrogate,
         }
     }
 }
