@@ -154,7 +154,7 @@ fn speeds_of(
             }
             Ok(v)
         }
-        None => Ok(chatter_stability::boundary::default_speeds_rpm(model)),
+        None => Ok(chatter_stability::speed_grid::default_speeds_rpm(model)),
     }
 }
 

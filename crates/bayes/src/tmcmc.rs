@@ -442,11 +442,5 @@ pub fn rejuvenate<P: Prior, L: LogLikelihood>(
 /// Posterior probabilities of model classes from their log-evidences (equal prior
 /// probabilities; 000 Eq. 32).
 pub fn class_probabilities(log_evidences: &[f64]) -> Vec<f64> {
-    let m = log_evidences
-        .iter()
-        .copied()
-        .fold(f64::NEG_INFINITY, f64::max);
-    let w: Vec<f64> = log_evidences.iter().map(|l| (l - m).exp()).collect();
-    let s: f64 = w.iter().sum();
-    w.iter().map(|x| x / s).collect()
+    crate::special::normalized_weights(log_evidences)
 }

@@ -608,25 +608,21 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     Ok(())
 }
 
-/// The posterior of 000 Section 6.4: mean [0.0067, 0.1385, 0.0549] and covariance (Eq. 34) of
-/// theta_omega_2, theta_zeta_2, theta_phi_2, written to `eq34_covariance.json` in `out_dir`.
+/// The posterior of 000 Section 6.4 (`chatter_dynamics::examples::ahmadi_2022_posterior`: the
+/// mean and the covariance of Eq. 34 of theta_omega_2, theta_zeta_2, theta_phi_2), written to
+/// `eq34_covariance.json` in `out_dir`.
 fn eq34_distribution(
     folder: &mut crate::output::Folder,
 ) -> Result<chatter_uncertainty::parameters::ParameterDistribution> {
-    let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
-    let mean = vec![0.0067, 0.1385, 0.0549];
-    let eq34 = vec![
-        vec![3.5e-7, -2.9e-5, -1.5e-5],
-        vec![-2.9e-5, 0.0042, 0.0019],
-        vec![-1.5e-5, 0.0019, 9.4e-4],
-    ];
-    let file = serde_json::json!({"parameter_names": names, "covariance": eq34, "mean": mean});
-    folder.add("eq34_covariance.json", serde_json::to_string_pretty(&file)?);
-    let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    folder.add(
+        "eq34_covariance.json",
+        chatter_dynamics::examples::AHMADI_2022_POSTERIOR,
+    );
+    let posterior = chatter_dynamics::examples::ahmadi_2022_posterior();
     Ok(chatter_uncertainty::parameters::ParameterDistribution::new(
-        &names,
-        mean,
-        eq34,
+        &posterior.parameter_names,
+        posterior.mean,
+        posterior.covariance,
         None,
         &folder.path_of("eq34_covariance.json"),
     )?)

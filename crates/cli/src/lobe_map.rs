@@ -45,10 +45,10 @@ pub fn default_depths_m(lobes: &[LobePoint]) -> Result<Vec<f64>> {
     if deepest <= 0.0 {
         bail!("no speed has a stability limit below the depth ceiling; give --depths for the map");
     }
-    let top = 1.5 * deepest;
-    Ok((1..=DEFAULT_MAP_DEPTHS)
-        .map(|i| top * i as f64 / DEFAULT_MAP_DEPTHS as f64)
-        .collect())
+    Ok(chatter_stability::speed_grid::depth_grid(
+        deepest,
+        DEFAULT_MAP_DEPTHS,
+    ))
 }
 
 /// |mu| at every (speed, depth), rows per speed, in parallel.

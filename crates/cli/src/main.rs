@@ -104,8 +104,9 @@ enum Command {
         plot: Option<PathBuf>,
         /// Resolution of fdm/sdm: steps over the cutting part of one delay (tooth period in
         /// milling, revolution in turning); default automatic (>= 40, 24 per vibration cycle).
+        /// At least 1: a discretization with zero steps is refused when the option is parsed.
         #[arg(long)]
-        cutting_steps: Option<usize>,
+        cutting_steps: Option<std::num::NonZeroUsize>,
         /// Map of the dominant multiplier's modulus |mu| over speed x depth: CSV
         /// speed_rpm,depth_mm,modulus (|mu| < 1 stable).
         #[arg(long)]
@@ -369,7 +370,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out.as_deref(),
             plot.as_deref(),
             &commands::LobeExtras {
-                cutting_steps,
+                cutting_steps: cutting_steps.map(std::num::NonZeroUsize::get),
                 map_out: map_out.as_deref(),
                 map_plot: map_plot.as_deref(),
                 depths: depths.as_deref(),

@@ -52,15 +52,13 @@ pub fn lobes(
     )?))
 }
 
-/// 200 speeds from a tenth of to 1.2 times the speed whose tooth-passing frequency is the
-/// receptance's peak (at most 60 000 rpm).
+/// The default speeds around the receptance's peak
+/// (`chatter_stability::speed_grid::even_lobe_speeds_rpm`).
 pub fn default_speeds(model: &MeasuredModel) -> Vec<f64> {
-    let f = model.receptance.peak_frequency_hz();
-    let n = model.operation.delays_per_revolution() as f64;
-    let max = (60.0 * f / n * 1.2).min(60_000.0);
-    (0..200)
-        .map(|i| max / 10.0 + (max - max / 10.0) * i as f64 / 199.0)
-        .collect()
+    chatter_stability::speed_grid::even_lobe_speeds_rpm(
+        model.receptance.peak_frequency_hz(),
+        model.operation.delays_per_revolution() as f64,
+    )
 }
 
 /// Arguments of `chatter fit-frf`.

@@ -287,19 +287,7 @@ fn write_outputs(
         }
         out.add("poles.csv", t);
     }
-    let n = r.posterior_covariance.nrows();
-    let covariance: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| r.posterior_covariance[(i, j)]).collect())
-        .collect();
-    let summary = serde_json::json!({
-        "parameter_names": r.parameter_names,
-        "posterior_mean": r.posterior_mean,
-        "posterior_covariance": covariance,
-        "classes": r.classes,
-        "selected_alpha": r.selected_alpha,
-        "prior_bound_pileups": r.prior_bound_pileups,
-        "surrogate": r.surrogate,
-    });
+    let summary = chatter_updating::update::PosteriorSummary::of(r);
     out.add(
         "summary.json",
         serde_json::to_string_pretty(&summary)? + "\n",

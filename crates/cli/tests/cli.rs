@@ -271,15 +271,16 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     assert_eq!(missing.status.code(), Some(1));
 }
 
-/// The Eq. 34 covariance of seed 000 as a covariance file (formats: README, `bands`).
+/// The Eq. 34 covariance of seed 000 as a covariance file without a mean (formats: README,
+/// `bands`), so the bands are around the nominal model.
 fn eq34_covariance(dir: &std::path::Path) -> PathBuf {
     let path = dir.join("eq34.json");
-    std::fs::write(
-        &path,
-        r#"{"parameter_names": ["theta_omega_2", "theta_zeta_2", "theta_phi_2"],
-            "covariance": [[3.5e-7, -2.9e-5, -1.5e-5], [-2.9e-5, 0.0042, 0.0019], [-1.5e-5, 0.0019, 9.4e-4]]}"#,
-    )
-    .unwrap();
+    let posterior = chatter_dynamics::examples::ahmadi_2022_posterior();
+    let file = serde_json::json!({
+        "parameter_names": posterior.parameter_names,
+        "covariance": posterior.covariance,
+    });
+    std::fs::write(&path, file.to_string()).unwrap();
     path
 }
 
@@ -838,8 +839,7 @@ fn oma_identifies_the_signals_of_an_observations_file() {
     let record = SyntheticRecord {
         channels: vec!["a1".into(), "a2".into()],
         modes: vec![SyntheticMode {
-            frequency_hz: 800.0,
-            damping_ratio: 0.02,
+            pole: chatter_dynamics::ModalPole::new(800.0, 0.02),
             shape: vec![1.0, 0.5],
         }],
         harmonics: Vec::new(),

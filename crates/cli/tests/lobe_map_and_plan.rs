@@ -77,6 +77,22 @@ fn lobes_write_a_modulus_map_consistent_with_the_limits() {
         ])
         .arg(example("schmitz2023_milling_model.json")));
     assert!(!ok && err.contains("--cutting-steps"), "{err}");
+    // zero steps is refused where the option is read, by its name
+    let (ok, _, err) = run(chatter()
+        .args([
+            "lobes",
+            "--quiet",
+            "--method",
+            "fdm",
+            "--cutting-steps",
+            "0",
+            "--model",
+        ])
+        .arg(example("schmitz2023_milling_model.json")));
+    assert!(
+        !ok && err.contains("--cutting-steps") && err.contains("'0'"),
+        "{err}"
+    );
     let (ok, _, err) = run(chatter()
         .args(["lobes", "--quiet", "--depths", "1:2:3", "--model"])
         .arg(example("schmitz2023_milling_model.json")));

@@ -13,6 +13,10 @@ pub const AHMADI_2022_TURNING_MODEL: &str = include_str!("../data/ahmadi2022_tur
 /// Observations of the turning case of seed 000: Table 2 poles and the Fig. 2 cuts.
 pub const AHMADI_2022_TURNING_OBSERVATIONS: &str =
     include_str!("../data/ahmadi2022_turning_observations.json");
+/// The posterior of seed 000's turning case (Section 6.4) over theta_omega_2, theta_zeta_2 and
+/// theta_phi_2: the published mean and covariance (Eq. 34), as a covariance file
+/// (`chatter bands --covariance`).
+pub const AHMADI_2022_POSTERIOR: &str = include_str!("../data/ahmadi2022_posterior.json");
 /// Model file of the milling example of Schmitz (2023), seed 001.
 pub const SCHMITZ_2023_MILLING_MODEL: &str = include_str!("../data/schmitz2023_milling_model.json");
 /// Model file of the experimental milling case of Ebrahimi-Tirtashi and Ahmadi (2025), seed 002.
@@ -43,6 +47,32 @@ fn embedded_model(text: &str, name: &str) -> ModalModel {
 fn embedded_observations(text: &str, name: &str) -> Observations {
     Observations::from_json_str(text, Path::new(name))
         .unwrap_or_else(|e| panic!("embedded example {name} is invalid: {e}"))
+}
+
+/// A published Gaussian posterior of named parameters: its mean and covariance.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct PublishedPosterior {
+    /// Parameter names (`chatter_dynamics::Parameter` syntax).
+    pub parameter_names: Vec<String>,
+    /// Posterior mean, in the order of the names.
+    pub mean: Vec<f64>,
+    /// Posterior covariance, row by row.
+    pub covariance: Vec<Vec<f64>>,
+}
+
+impl PublishedPosterior {
+    /// The covariance as a matrix.
+    pub fn covariance_matrix(&self) -> nalgebra::DMatrix<f64> {
+        let n = self.covariance.len();
+        nalgebra::DMatrix::from_fn(n, n, |i, j| self.covariance[i][j])
+    }
+}
+
+/// Seed 000's posterior after updating (Section 6.4): mean (0.0067, 0.1385, 0.0549) and the
+/// covariance of Eq. 34 ([`AHMADI_2022_POSTERIOR`]).
+pub fn ahmadi_2022_posterior() -> PublishedPosterior {
+    serde_json::from_str(AHMADI_2022_POSTERIOR)
+        .unwrap_or_else(|e| panic!("embedded example ahmadi2022_posterior.json is invalid: {e}"))
 }
 
 /// Turning tool of seed 000 (Table 1; kt 635, kfc 159 N/mm^2).

@@ -36,11 +36,11 @@ pub mod model_file;
 pub mod observations;
 pub mod operation;
 pub mod perturbation;
-pub mod pole;
 mod resample;
 pub mod sampled;
 pub mod simulate;
 
+pub use chatter_modal::{ModalPole, pole};
 pub use error::{DynamicsError, Result};
 pub use model::{CuttingCoefficients, ModalModel, Mode, ModeShape, ResidualTerms};
 pub use model_file::{MeasuredFrfFile, ModelFile};

@@ -31,6 +31,7 @@
 
 use crate::error::{DynamicsError, Result, finite, non_negative, positive};
 use crate::operation::Operation;
+use chatter_modal::ModalPole;
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -66,11 +67,11 @@ pub enum ModeShape {
     MassNormalized([f64; 2]),
 }
 
-/// One structural mode.
+/// One structural mode: its modal pole (natural frequency and damping ratio, the
+/// [`ModalPole`] every mode type of the workspace holds), its shape and its residue phase.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mode {
-    frequency_hz: f64,
-    damping_ratio: f64,
+    pole: ModalPole,
     shape: ModeShape,
     residue_phase_rad: f64,
 }
@@ -114,8 +115,7 @@ impl Mode {
             }
         }
         Ok(Self {
-            frequency_hz,
-            damping_ratio,
+            pole: ModalPole::new(frequency_hz, damping_ratio),
             shape,
             residue_phase_rad: 0.0,
         })
@@ -132,7 +132,7 @@ impl Mode {
                 "a phase in (-180, 180] degrees",
             ));
         }
-        if residue_phase_rad != 0.0 && self.damping_ratio == 0.0 {
+        if residue_phase_rad != 0.0 && self.pole.damping_ratio == 0.0 {
             return Err(DynamicsError::invalid(
                 "residue_phase_deg",
                 "a non-proportional (complex) mode needs a damping ratio > 0",
@@ -155,8 +155,8 @@ impl Mode {
     ) -> Result<Self> {
         let magnitude = residue_m_per_n_s.norm();
         positive("residue_m_per_n_s", magnitude)?;
-        let wn = 2.0 * PI * frequency_hz;
-        let wd = wn * (1.0 - damping_ratio * damping_ratio).max(0.0).sqrt();
+        let pole = ModalPole::new(frequency_hz, damping_ratio);
+        let (wn, wd) = (pole.omega_rad_s(), pole.pole().im);
         let alpha = (Complex64::i() * residue_m_per_n_s).arg();
         let shape = ModeShape::Directional {
             coordinate,
@@ -177,22 +177,26 @@ impl Mode {
     pub fn receptance_numerator(&self) -> (f64, f64) {
         complex_mode_numerator(
             self.omega_rad_s(),
-            self.damping_ratio,
+            self.pole.damping_ratio,
             self.residue_phase_rad,
         )
     }
 
     /// Natural frequency in Hz.
     pub fn frequency_hz(&self) -> f64 {
-        self.frequency_hz
+        self.pole.frequency_hz
     }
     /// Natural frequency omega_n in rad/s.
     pub fn omega_rad_s(&self) -> f64 {
-        2.0 * PI * self.frequency_hz
+        self.pole.omega_rad_s()
     }
     /// Damping ratio zeta_n.
     pub fn damping_ratio(&self) -> f64 {
-        self.damping_ratio
+        self.pole.damping_ratio
+    }
+    /// The natural frequency and damping ratio as a [`ModalPole`].
+    pub fn modal_pole(&self) -> ModalPole {
+        self.pole
     }
     /// How the shape was given.
     pub fn shape(&self) -> ModeShape {
@@ -228,8 +232,7 @@ impl Mode {
         shape: ModeShape,
     ) -> Self {
         Self {
-            frequency_hz,
-            damping_ratio,
+            pole: ModalPole::new(frequency_hz, damping_ratio),
             shape,
             ..self
         }

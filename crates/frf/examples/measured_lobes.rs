@@ -44,7 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for m in &fit.modes {
         println!(
             "fitted mode {:.1} Hz, zeta {:.4}, k {:?} N/m (NRMSE {:.2e})",
-            m.frequency_hz, m.damping_ratio, m.stiffness_n_per_m, fit.relative_misfit
+            m.pole.frequency_hz, m.pole.damping_ratio, m.stiffness_n_per_m, fit.relative_misfit
         );
     }
     Ok(())

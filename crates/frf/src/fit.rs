@@ -35,7 +35,8 @@
 
 use crate::error::{FrfError, Result};
 use crate::frf::Frf;
-use chatter_dynamics::{Mode, ModeShape};
+use chatter_dynamics::pole::{pole_frequency_damping, pole_from_frequency_damping};
+use chatter_dynamics::{ModalPole, Mode, ModeShape};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -102,10 +103,10 @@ pub enum Residuals {
 /// it as the model's [`Mode`], which holds the pole-residue conversion (one place).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FittedMode {
-    /// Natural frequency (Hz).
-    pub frequency_hz: f64,
-    /// Damping ratio.
-    pub damping_ratio: f64,
+    /// Natural frequency (Hz) and damping ratio: the modal pole every mode type holds (written
+    /// as the two fields `frequency_hz`, `damping_ratio`).
+    #[serde(flatten)]
+    pub pole: ModalPole,
     /// Complex residue A_r of the complex-mode fit (m/(N s)), real and imaginary parts.
     pub residue_m_per_n_s: [f64; 2],
     /// Stiffness (N/m) of the real-mode fit at the measured point; None where that fit gives
@@ -156,8 +157,8 @@ impl FittedMode {
     /// [`Mode::from_residue`]).
     pub fn complex_mode(&self, coordinate: usize) -> Result<Mode> {
         Ok(Mode::from_residue(
-            self.frequency_hz,
-            self.damping_ratio,
+            self.pole.frequency_hz,
+            self.pole.damping_ratio,
             coordinate,
             self.residue(),
         )?)
@@ -170,14 +171,8 @@ impl FittedMode {
             coordinate,
             stiffness_n_per_m: self.stiffness_n_per_m?,
         };
-        Mode::new(self.frequency_hz, self.damping_ratio, shape).ok()
+        Mode::new(self.pole.frequency_hz, self.pole.damping_ratio, shape).ok()
     }
-}
-
-fn pole(mode: &FittedMode) -> Complex64 {
-    let w = 2.0 * PI * mode.frequency_hz;
-    let z = mode.damping_ratio;
-    Complex64::new(-z * w, w * (1.0 - z * z).sqrt())
 }
 
 impl ModalFit {
@@ -199,7 +194,7 @@ impl ModalFit {
             h -= self.lower_residual_per_kg / (w * w);
         }
         for m in &self.modes {
-            let s = pole(m);
+            let s = m.pole.pole();
             let a = m.residue();
             h += a / (iw - s) + a.conj() / (iw - s.conj());
         }
@@ -302,11 +297,6 @@ fn lscf_poles(l: &Lags, n: usize, dt: f64) -> Option<Vec<Complex64>> {
     )
 }
 
-/// Frequency (Hz) and damping ratio of a pole.
-fn modal(s: Complex64) -> (f64, f64) {
-    (s.norm() / (2.0 * PI), -s.re / s.norm())
-}
-
 /// Linear least squares for the residues of `poles` (and the residual terms): the fitted
 /// coefficients [per mode (Re A, Im A) or Im A only, then U, then L].
 fn residues(
@@ -394,10 +384,7 @@ fn misfit_vector(
 fn poles_of(theta: &[f64]) -> Vec<Complex64> {
     theta
         .chunks(2)
-        .map(|c| {
-            let (w, z) = (2.0 * PI * c[0].exp(), c[1].exp().min(0.99));
-            Complex64::new(-z * w, w * (1.0 - z * z).sqrt())
-        })
+        .map(|c| pole_from_frequency_damping(c[0].exp(), c[1].exp().min(0.99)))
         .collect()
 }
 
@@ -519,7 +506,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
         let mut phys: Vec<(f64, f64)> = poles
             .iter()
             .filter(|s| s.im > 0.0 && s.re < 0.0)
-            .map(|&s| modal(s))
+            .map(|&s| pole_frequency_damping(s))
             .filter(|&(f, z)| f >= x[0] && f <= f_hi && z > 0.0 && z < 0.5)
             .collect();
         phys.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -607,10 +594,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
     let fit = |chosen: &[Candidate]| -> Result<(Vec<f64>, Vec<Complex64>)> {
         let poles: Vec<Complex64> = chosen
             .iter()
-            .map(|&(f, z, _)| {
-                let w = 2.0 * PI * f;
-                Complex64::new(-z * w, w * (1.0 - z * z).sqrt())
-            })
+            .map(|&(f, z, _)| pole_from_frequency_damping(f, z))
             .collect();
         let c = residues(x, &h, &poles, true, residual_columns)
             .ok_or_else(|| FrfError::Fit("the residue least squares failed".into()))?;
@@ -728,8 +712,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
             let phi2 = -2.0 * wd * real[r] * scale;
             let wn = 2.0 * PI * f;
             FittedMode {
-                frequency_hz: f,
-                damping_ratio: z,
+                pole: ModalPole::new(f, z),
                 residue_m_per_n_s: [coeffs[2 * r] * scale, coeffs[2 * r + 1] * scale],
                 stiffness_n_per_m: (phi2 > 0.0).then(|| wn * wn / phi2),
                 stability_share: share,
@@ -742,7 +725,7 @@ pub fn fit_modes(frf: &Frf, fmin_hz: f64, fmax_hz: f64, options: &FitOptions) ->
     } else {
         0.0
     };
-    modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    modes.sort_by(|a, b| a.pole.frequency_hz.total_cmp(&b.pole.frequency_hz));
     let mut out = ModalFit {
         band_hz: (fmin_hz, fmax_hz),
         modes,

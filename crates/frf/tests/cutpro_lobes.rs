@@ -256,8 +256,8 @@ fn print_fit(name: &str, fit: &ModalFit) {
     for m in &fit.modes {
         eprintln!(
             "  {:.2} Hz, zeta {:.5}, residue {:.4e} {:+.4e}i m/(N s), real-mode k {:?} N/m",
-            m.frequency_hz,
-            m.damping_ratio,
+            m.pole.frequency_hz,
+            m.pole.damping_ratio,
             m.residue_m_per_n_s[0],
             m.residue_m_per_n_s[1],
             m.stiffness_n_per_m
@@ -370,8 +370,8 @@ fn real_cutpro_lobes_direct_checked_and_from_the_fit_within_three_percent() {
             .map(|m| {
                 format!(
                     r#"{{"frequency_hz": {}, "damping_ratio": {}, "stiffness_n_per_m": {}, "direction": "{dir}"}}"#,
-                    m.frequency_hz,
-                    m.damping_ratio,
+                    m.pole.frequency_hz,
+                    m.pole.damping_ratio,
                     m.stiffness_n_per_m.unwrap()
                 )
             })

@@ -57,8 +57,8 @@ fn synthetic_three_modes_with_two_percent_noise() {
         assert_eq!(fit.modes.len(), 3, "seed {seed}: {:?}", fit.modes);
         for (m, &(f, z, k)) in fit.modes.iter().zip(&MODES) {
             let (ef, ez) = (
-                (m.frequency_hz / f - 1.0).abs(),
-                (m.damping_ratio / z - 1.0).abs(),
+                (m.pole.frequency_hz / f - 1.0).abs(),
+                (m.pole.damping_ratio / z - 1.0).abs(),
             );
             let ek = (m.stiffness_n_per_m.unwrap() / k - 1.0).abs();
             eprintln!(
@@ -90,7 +90,7 @@ fn real_tap_test_tip_frf_fitted_within_five_percent() {
     for m in &fit.modes {
         eprintln!(
             "{:.1} Hz zeta {:.4} k {:?} share {:.2}",
-            m.frequency_hz, m.damping_ratio, m.stiffness_n_per_m, m.stability_share
+            m.pole.frequency_hz, m.pole.damping_ratio, m.stiffness_n_per_m, m.stability_share
         );
     }
     eprintln!(
@@ -109,15 +109,15 @@ fn real_tap_test_tip_frf_fitted_within_five_percent() {
         .max_by(|a, b| {
             let ka = a
                 .stiffness_n_per_m
-                .map_or(0.0, |k| 1.0 / (k * a.damping_ratio));
+                .map_or(0.0, |k| 1.0 / (k * a.pole.damping_ratio));
             let kb = b
                 .stiffness_n_per_m
-                .map_or(0.0, |k| 1.0 / (k * b.damping_ratio));
+                .map_or(0.0, |k| 1.0 / (k * b.pole.damping_ratio));
             ka.total_cmp(&kb)
         })
         .unwrap();
     assert!(
-        (dominant.frequency_hz - 1068.0).abs() < 30.0,
+        (dominant.pole.frequency_hz - 1068.0).abs() < 30.0,
         "{dominant:?}"
     );
 }

@@ -231,10 +231,14 @@ pub(crate) fn predict_pole(
 /// A continuous-time pole as it is identified: frequency |Im lambda| / 2 pi for a lifted
 /// (milling) pole, |lambda| / 2 pi for a physical one (000 Eq. 6); damping -Re lambda / |lambda|.
 pub(crate) fn observed_pole(lambda: Complex64, lifted: bool) -> PredictedPole {
-    let w = lambda.norm();
+    let (natural_hz, damping_ratio) = chatter_dynamics::pole::pole_frequency_damping(lambda);
     PredictedPole {
-        frequency_hz: if lifted { lambda.im.abs() } else { w } / (2.0 * PI),
-        damping_ratio: if w > 0.0 { -lambda.re / w } else { 0.0 },
+        frequency_hz: if lifted {
+            lambda.im.abs() / (2.0 * PI)
+        } else {
+            natural_hz
+        },
+        damping_ratio,
     }
 }
 

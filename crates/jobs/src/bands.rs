@@ -87,9 +87,10 @@ pub fn default_depths_mm(reference: &[LobePoint]) -> Result<Vec<f64>> {
             expected: "a depth grid: no finite limiting depth over these speeds".into(),
         });
     }
-    Ok((1..=DEFAULT_DEPTHS)
-        .map(|j| 1.5 * top * j as f64 / DEFAULT_DEPTHS as f64)
-        .collect())
+    Ok(chatter_stability::speed_grid::depth_grid(
+        top,
+        DEFAULT_DEPTHS,
+    ))
 }
 
 /// Credibility bounds at the distribution's mean.

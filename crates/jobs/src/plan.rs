@@ -128,10 +128,20 @@ pub fn plan(
 }
 
 /// The warnings of a plan, in the one wording that `chatter plan` prints (after `warning: `),
-/// its report page shows and the Python package returns: a next cut proposed at the deepest
-/// candidate depth because the P_s = `p_test` contour lies above the grid (a clipped grid).
+/// its report page shows and the Python package returns: sampled paths dropped because their
+/// stability boundary failed, then a next cut proposed at the deepest candidate depth because
+/// the P_s = `p_test` contour lies above the grid (a clipped grid).
 pub fn warnings(outcome: &PlanOutcome, request: &PlanRequest) -> Vec<String> {
-    outcome
+    let failed = outcome.boundaries.failures.first().map(|first| {
+        format!(
+            "{} of {} sampled paths were dropped because their stability boundary failed (first: \
+             {}); P_s and the next cut are over the other paths (`failed_paths` in the JSON)",
+            outcome.failed_paths,
+            outcome.failed_paths + outcome.boundaries.limits_mm.len(),
+            first.message
+        )
+    });
+    let clipped = outcome
         .next_cut
         .iter()
         .filter(|t| t.on_contour == Some(false))
@@ -142,6 +152,6 @@ pub fn warnings(outcome: &PlanOutcome, request: &PlanRequest) -> Vec<String> {
                  give deeper --depths",
                 request.p_test, t.speed_rpm, t.depth_mm, t.p_stable
             )
-        })
-        .collect()
+        });
+    failed.into_iter().chain(clipped).collect()
 }

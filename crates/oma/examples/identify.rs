@@ -20,7 +20,7 @@ fn main() -> Result<(), chatter_oma::OmaError> {
     let id = identify(&signals, &options)?;
     println!("true modes (Hz, damping ratio):");
     for m in &record.modes {
-        println!("  {:8.2}  {:.4}", m.frequency_hz, m.damping_ratio);
+        println!("  {:8.2}  {:.4}", m.pole.frequency_hz, m.pole.damping_ratio);
     }
     println!("imposed harmonics (Hz): {:.1?}", id.harmonics_hz);
     println!("stable clusters of the whole-record diagram (orders, Hz, damping ratio):");

@@ -14,6 +14,7 @@
 //! annihilates the harmonic components, and U (order 2P - 2H) is fitted to the filtered sequence.
 
 use crate::error::{OmaError, Result};
+use chatter_modal::pole::pole_frequency_damping;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -37,12 +38,12 @@ impl Pole {
     /// The pole of a discrete multiplier at sample interval `ts`.
     pub fn from_multiplier(mu: Complex64, ts: f64, harmonic: bool) -> Self {
         let lambda = mu.ln() / ts;
-        let w = lambda.norm();
+        let (frequency_hz, damping_ratio) = pole_frequency_damping(lambda);
         Self {
             multiplier: mu,
             lambda,
-            frequency_hz: w / (2.0 * PI),
-            damping_ratio: if w > 0.0 { -lambda.re / w } else { 0.0 },
+            frequency_hz,
+            damping_ratio,
             harmonic,
         }
     }

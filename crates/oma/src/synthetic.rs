@@ -11,19 +11,20 @@
 
 use crate::error::{OmaError, Result};
 use crate::signals::Signals;
+use chatter_modal::ModalPole;
 use nalgebra::Matrix3;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// A mode of the synthetic system.
+/// A mode of the synthetic system: a modal pole with its participation per channel.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SyntheticMode {
-    /// Natural frequency (Hz).
-    pub frequency_hz: f64,
-    /// Damping ratio, in [0, 1).
-    pub damping_ratio: f64,
+    /// Natural frequency (Hz) and damping ratio, in [0, 1): the modal pole every mode type
+    /// holds (written as the two fields `frequency_hz`, `damping_ratio`).
+    #[serde(flatten)]
+    pub pole: ModalPole,
     /// Participation in each channel (one value per channel).
     pub shape: Vec<f64>,
 }
@@ -72,8 +73,7 @@ impl SyntheticRecord {
         Self {
             channels: vec!["y".into()],
             modes: vec![SyntheticMode {
-                frequency_hz,
-                damping_ratio,
+                pole: ModalPole::new(frequency_hz, damping_ratio),
                 shape: vec![1.0],
             }],
             harmonics: Vec::new(),
@@ -92,8 +92,7 @@ impl SyntheticRecord {
     pub fn four_channel_reference(sample_rate_hz: f64, duration_s: f64, seed: u64) -> Self {
         let spindle_hz = 7150.0 / 60.0;
         let mode = |frequency_hz, damping_ratio, shape: [f64; 4]| SyntheticMode {
-            frequency_hz,
-            damping_ratio,
+            pole: ModalPole::new(frequency_hz, damping_ratio),
             shape: shape.to_vec(),
         };
         Self {
@@ -138,9 +137,9 @@ impl SyntheticRecord {
             return invalid("noise_fraction", format!("{}", self.noise_fraction));
         }
         for (i, m) in self.modes.iter().enumerate() {
-            let valid = m.frequency_hz > 0.0
-                && m.frequency_hz < nyquist
-                && (0.0..1.0).contains(&m.damping_ratio)
+            let valid = m.pole.frequency_hz > 0.0
+                && m.pole.frequency_hz < nyquist
+                && (0.0..1.0).contains(&m.pole.damping_ratio)
                 && m.shape.len() == nc;
             if !valid {
                 return invalid(
@@ -171,11 +170,11 @@ impl SyntheticRecord {
         let mut rng = rand::rngs::StdRng::seed_from_u64(self.seed);
         let mut data = vec![vec![0.0; n]; nc];
         for mode in &self.modes {
-            let (phi, gamma) = zoh_transition(mode.frequency_hz, mode.damping_ratio, ts);
+            let (phi, gamma) = zoh_transition(mode.pole.frequency_hz, mode.pole.damping_ratio, ts);
             let (mut q, mut qd) = (0.0, 0.0);
             // start in the stationary state: discard ten decay times (at most 1e6 samples)
-            let w = 2.0 * PI * mode.frequency_hz;
-            let warmup = (10.0 / (mode.damping_ratio * w).max(1e-12) / ts).min(1e6) as usize;
+            let w = mode.pole.omega_rad_s();
+            let warmup = (10.0 / (mode.pole.damping_ratio * w).max(1e-12) / ts).min(1e6) as usize;
             for k in 0..warmup + n {
                 let f: f64 = StandardNormal.sample(&mut rng);
                 (q, qd) = (

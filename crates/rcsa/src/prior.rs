@@ -124,11 +124,11 @@ pub fn rcsa_prior(assembly: &Assembly, settings: &PriorSettings) -> Result<Modal
                 .iter()
                 .map(|m| {
                     m.stiffness_n_per_m
-                        .map(|s| [m.frequency_hz, s, m.damping_ratio])
+                        .map(|s| [m.pole.frequency_hz, s, m.pole.damping_ratio])
                         .ok_or_else(|| {
                             RcsaError::Frf(chatter_frf::FrfError::Fit(format!(
                                 "the mode at {:.1} Hz (k = {k:.3e}, c = {c:.2}) is not a real mode",
-                                m.frequency_hz
+                                m.pole.frequency_hz
                             )))
                         })
                 })

@@ -418,23 +418,6 @@ pub fn multiplier_grid<S: StabilitySolver + ?Sized>(
         .collect()
 }
 
-/// Number of speeds of [`default_speeds_rpm`].
-pub const DEFAULT_SPEED_COUNT: usize = 200;
-
-/// The default speed range of a lobe diagram: [`DEFAULT_SPEED_COUNT`] evenly spaced speeds
-/// around the lobes of the dominant mode ([`dominant_mode_frequency_hz`] f_d), from a tenth of
-/// the maximum to 1.2 f_d x 60 / (delays per revolution) rpm (lobe numbers ~1 to 10), capped at
-/// 60 000 rpm.
-pub fn default_speeds_rpm(model: &ModalModel) -> Vec<f64> {
-    let f = dominant_mode_frequency_hz(model);
-    let n = model.operation().delays_per_revolution() as f64;
-    let max = (60.0 * f / n * 1.2).min(60_000.0);
-    let min = max / 10.0;
-    (0..DEFAULT_SPEED_COUNT)
-        .map(|i| min + (max - min) * i as f64 / (DEFAULT_SPEED_COUNT - 1) as f64)
-        .collect()
-}
-
 /// `n` evenly spaced speeds from `min_rpm` to `max_rpm` inclusive.
 pub fn speed_range(min_rpm: f64, max_rpm: f64, n: usize) -> Result<Vec<f64>> {
     if !(min_rpm > 0.0 && max_rpm > min_rpm && n >= 2) {
@@ -444,7 +427,5 @@ pub fn speed_range(min_rpm: f64, max_rpm: f64, n: usize) -> Result<Vec<f64>> {
             expected: "0 < min < max and at least 2 speeds",
         });
     }
-    Ok((0..n)
-        .map(|i| min_rpm + (max_rpm - min_rpm) * i as f64 / (n - 1) as f64)
-        .collect())
+    Ok(crate::speed_grid::evenly_spaced(min_rpm, max_rpm, n))
 }

@@ -1,4 +1,8 @@
-//! Default spindle-speed grids that resolve every lobe.
+//! Default spindle-speed and depth grids: the one home of the defaults every front end uses.
+//!
+//! Speeds: [`lobe_speeds_rpm`] resolves every lobe; [`default_speeds_rpm`] and
+//! [`even_lobe_speeds_rpm`] are 200 evenly spaced speeds over the same range
+//! ([`lobe_range_rpm`]). Depths: [`depth_grid`] up to 1.5 times the deepest limit.
 //!
 //! The lobes of a mode f (Hz) at z delays per revolution lie at lobe numbers
 //! N = 60 f / (z n) (n in rpm), one lobe per unit of N, so in speed they crowd together as
@@ -15,14 +19,57 @@ pub const POINTS_PER_LOBE: f64 = 20.0;
 /// Fewest and most speeds of [`lobe_speeds_rpm`].
 pub const SPEED_COUNT_RANGE: (usize, usize) = (200, 2000);
 
-/// Speeds from a tenth of the top to 1.2 f_d x 60 / z rpm (f_d the dominant mode,
-/// [`dominant_mode_frequency_hz`]; capped at 60 000 rpm), evenly spaced in the lobe number
-/// N = 60 f_d / (z n): [`POINTS_PER_LOBE`] per lobe, within [`SPEED_COUNT_RANGE`]; ascending.
+/// Number of speeds of [`default_speeds_rpm`] and [`even_lobe_speeds_rpm`].
+pub const DEFAULT_SPEED_COUNT: usize = 200;
+/// The deepest depth of [`depth_grid`] as a multiple of the deepest limit.
+pub const DEPTH_GRID_TOP: f64 = 1.5;
+
+/// The speed range (min, max) in rpm of the lobes of a mode at `frequency_hz` with
+/// `delays_per_revolution` delays per revolution (z): from a tenth of the top to
+/// 1.2 f x 60 / z rpm (lobe numbers ~1 to 10), the top capped at 60 000 rpm.
+pub fn lobe_range_rpm(frequency_hz: f64, delays_per_revolution: f64) -> (f64, f64) {
+    let max = (60.0 * frequency_hz / delays_per_revolution * 1.2).min(60_000.0);
+    (max / 10.0, max)
+}
+
+/// [`DEFAULT_SPEED_COUNT`] speeds evenly spaced over [`lobe_range_rpm`] (a measured model's
+/// default, with its receptance peak for the mode).
+pub fn even_lobe_speeds_rpm(frequency_hz: f64, delays_per_revolution: f64) -> Vec<f64> {
+    let (min, max) = lobe_range_rpm(frequency_hz, delays_per_revolution);
+    evenly_spaced(min, max, DEFAULT_SPEED_COUNT)
+}
+
+/// [`even_lobe_speeds_rpm`] of the model's dominant mode ([`dominant_mode_frequency_hz`]).
+pub fn default_speeds_rpm(model: &ModalModel) -> Vec<f64> {
+    even_lobe_speeds_rpm(
+        dominant_mode_frequency_hz(model),
+        model.operation().delays_per_revolution() as f64,
+    )
+}
+
+/// `n >= 2` evenly spaced values from `min` to `max` inclusive.
+pub(crate) fn evenly_spaced(min: f64, max: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| min + (max - min) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// `count` depths from 1 / `count` to [`DEPTH_GRID_TOP`] times `deepest` (in the unit of
+/// `deepest`): the default depth grid of maps and bands over lobes whose deepest finite limit
+/// is `deepest`.
+pub fn depth_grid(deepest: f64, count: usize) -> Vec<f64> {
+    (1..=count)
+        .map(|j| DEPTH_GRID_TOP * deepest * j as f64 / count as f64)
+        .collect()
+}
+
+/// Speeds over [`lobe_range_rpm`] of the dominant mode f_d ([`dominant_mode_frequency_hz`]),
+/// evenly spaced in the lobe number N = 60 f_d / (z n): [`POINTS_PER_LOBE`] per lobe, within
+/// [`SPEED_COUNT_RANGE`]; ascending.
 pub fn lobe_speeds_rpm(model: &ModalModel) -> Vec<f64> {
     let f = dominant_mode_frequency_hz(model);
     let z = model.operation().delays_per_revolution() as f64;
-    let max = (60.0 * f / z * 1.2).min(60_000.0);
-    let min = max / 10.0;
+    let (min, max) = lobe_range_rpm(f, z);
     let lobe = |n: f64| 60.0 * f / (z * n);
     let (lo, hi) = (lobe(max), lobe(min));
     let count = ((POINTS_PER_LOBE * (hi - lo)).ceil() as usize)

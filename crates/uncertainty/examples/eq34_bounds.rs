@@ -7,7 +7,6 @@
 use chatter_dynamics::{Parameter, examples};
 use chatter_stability::monodromy::Discretization;
 use chatter_uncertainty::perturbation::model_moment_grid;
-use nalgebra::DMatrix;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let model = examples::ahmadi_2022_turning();
@@ -15,15 +14,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|s| s.parse())
         .collect::<Result<Vec<Parameter>, _>>()?;
-    // Eq. 34
-    let sigma = DMatrix::from_row_slice(
-        3,
-        3,
-        &[
-            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
-        ],
-    );
-    let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549])?;
+    let posterior = examples::ahmadi_2022_posterior();
+    let sigma = posterior.covariance_matrix();
+    let updated = model.perturbed(&params, &posterior.mean)?;
     let depths_mm: Vec<f64> = (0..=60).map(|j| 1.0 + 0.05 * f64::from(j)).collect();
     let speeds_rpm = [6950.0, 7150.0, 7300.0, 7500.0];
     let show = |x: Option<f64>| x.map_or_else(|| "> 4".to_string(), |v| format!("{v:.3}"));

@@ -4,8 +4,8 @@
 //! Files (the toolkit's own, written by `chatter update` or by hand):
 //! - covariance file: `{"parameter_names": ["theta_omega_2", ...], "covariance": [[...], ...],
 //!   "mean": [...]}` (`mean` optional, zero by default);
-//! - posterior folder: `summary.json` with `parameter_names`, `posterior_mean` and
-//!   `posterior_covariance`, and optionally `posterior.csv` whose header names the parameters and
+//! - posterior folder: `summary.json` ([`PosteriorSummary`]: `parameter_names`,
+//!   `posterior_mean` and `posterior_covariance`), and optionally `posterior.csv` whose header names the parameters and
 //!   whose rows are samples.
 //!
 //! The names are those of `chatter update` (`chatter_updating::parameters::ModelParameter`):
@@ -19,6 +19,7 @@ use crate::error::{Result, UncertaintyError};
 use crate::montecarlo::gaussian_draws;
 use chatter_dynamics::{ModalModel, Parameter};
 use chatter_updating::parameters::{ModelParameter, Parameterization};
+use chatter_updating::update::PosteriorSummary;
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -50,13 +51,6 @@ struct CovarianceFile {
     covariance: Vec<Vec<f64>>,
     #[serde(default)]
     mean: Option<Vec<f64>>,
-}
-
-#[derive(serde::Deserialize)]
-struct SummaryFile {
-    parameter_names: Vec<String>,
-    posterior_mean: Vec<f64>,
-    posterior_covariance: Vec<Vec<f64>>,
 }
 
 impl ParameterDistribution {
@@ -185,7 +179,7 @@ impl ParameterDistribution {
     pub fn from_posterior_dir(dir: &Path) -> Result<Self> {
         let summary_path = dir.join("summary.json");
         let text = read(&summary_path)?;
-        let s: SummaryFile =
+        let s: PosteriorSummary =
             serde_json::from_str(&text).map_err(|e| invalid(&summary_path, e.to_string()))?;
         let csv_path = dir.join("posterior.csv");
         let samples = if csv_path.exists() {

@@ -20,13 +20,7 @@ fn mode2_parameters() -> Vec<Parameter> {
 
 /// The posterior covariance of seed 000, Eq. 34.
 fn eq34() -> DMatrix<f64> {
-    DMatrix::from_row_slice(
-        3,
-        3,
-        &[
-            3.5e-7, -2.9e-5, -1.5e-5, -2.9e-5, 0.0042, 0.0019, -1.5e-5, 0.0019, 9.4e-4,
-        ],
-    )
+    examples::ahmadi_2022_posterior().covariance_matrix()
 }
 
 /// With a small covariance (a tenth of the seed-000 posterior, Eq. 34) the Eq. 17-18 mean and
@@ -74,7 +68,9 @@ fn moments_match_monte_carlo_and_widen() {
 fn eq34_stable_cuts_lie_below_the_lower_bound() {
     let model = examples::ahmadi_2022_turning();
     let (params, eq34) = (mode2_parameters(), eq34());
-    let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549]).unwrap();
+    let updated = model
+        .perturbed(&params, &examples::ahmadi_2022_posterior().mean)
+        .unwrap();
     // Table 2 stable cuts (rpm, mm).
     let stable = [
         (7150.0, 2.286),
@@ -110,7 +106,9 @@ fn updated_bounds_cover_the_range_and_bracket_the_7300_rpm_cuts() {
     use chatter_uncertainty::perturbation::BoundRule;
     let model = examples::ahmadi_2022_turning();
     let (params, eq34) = (mode2_parameters(), eq34());
-    let updated = model.perturbed(&params, &[0.0067, 0.1385, 0.0549]).unwrap();
+    let updated = model
+        .perturbed(&params, &examples::ahmadi_2022_posterior().mean)
+        .unwrap();
     let speeds: Vec<f64> = (0..10).map(|i| 6800.0 + 100.0 * f64::from(i)).collect();
     let depths: Vec<f64> = (0..=80).map(|j| 1.5 + 0.05 * f64::from(j)).collect();
     let grid = model_moment_grid(

@@ -15,11 +15,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for form in [ResidualForm::Determinant, ResidualForm::PoleError] {
         let like = TurningPoleLikelihood::new(params.clone(), poles.clone(), 0.5, form)?;
         println!("{form:?}");
-        for theta in [
-            [0.0, 0.0, 0.0],
-            [0.0067, 0.1385, 0.0549],
-            [0.0146, -0.774, -0.651],
-        ] {
+        let published = chatter_dynamics::examples::ahmadi_2022_posterior().mean;
+        for theta in [vec![0.0, 0.0, 0.0], published, vec![0.0146, -0.774, -0.651]] {
             let r = like.normalized_residuals(&theta)?;
             let n = r.len() as f64;
             let re: f64 = r.iter().map(|x| x.0 * x.0).sum::<f64>() / n;

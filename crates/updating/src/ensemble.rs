@@ -19,6 +19,13 @@
 //! maximizes it over the speed x depth grid, and testing stops when the best expected reduction
 //! is small.
 //!
+//! A path whose boundary cannot be computed at a speed (the solver fails, or refuses the
+//! path's model) is dropped from the ensemble with its probability and recorded as a
+//! [`SampleFailure`] ([`BoundaryEnsemble::failures`]): it is read neither as stable nor as
+//! unstable, and the other paths go on. P_s, the moments and the value of information are then
+//! over the paths that have a boundary at every speed of the grid, as for the Monte Carlo map
+//! ([`crate::sampled`]), which keeps a sample's other speeds because it is not reweighted.
+//!
 //! Risk-based selection (004 Section 3): on the contour P_s = P_test (for each speed, the deepest
 //! grid depth with P_s >= P_test) the test is the point of maximum material removal rate; testing
 //! stops when the next test would improve the best stable MRR by less than 10 %.
@@ -28,7 +35,7 @@ use crate::cuts::{CutKernel, CutsLikelihood};
 use crate::error::{Result, UpdatingError};
 use crate::joint_prior::{SampledPrior, sample_posterior_whitened};
 use crate::parameters::Parameterization;
-use crate::sampled::{SampledBoundaries, boundary_of};
+use crate::sampled::{SampleFailure, SampledBoundaries, boundary_of};
 use chatter_bayes::Prior;
 use chatter_bayes::samples::SampleSet;
 use chatter_bayes::special::normalized_weights;
@@ -99,7 +106,14 @@ pub struct BoundaryEnsemble {
     columns: Vec<Column>,
     ln_weights: Vec<f64>,
     options: SolverOptions,
+    /// Index of each path among the samples the ensemble was built from.
+    path_ids: Vec<usize>,
+    failures: Vec<SampleFailure>,
 }
+
+/// One path's limiting depths at the new speeds, or the speed (None: all) and error of its
+/// failure.
+type PathRow = std::result::Result<Vec<LobePoint>, (Option<f64>, UpdatingError)>;
 
 /// A random stream per path, independent of the thread that computes it.
 fn path_stream(seed: u64, path: usize) -> StdRng {
@@ -111,10 +125,31 @@ fn path_stream(seed: u64, path: usize) -> StdRng {
 
 impl BoundaryEnsemble {
     /// Paths from given parameter samples, equally likely, with their boundaries at
-    /// `speeds_rpm`. Samples whose model cannot be built are errors.
+    /// `speeds_rpm`. Samples whose model cannot be built are errors; paths whose boundary
+    /// fails are dropped and counted ([`Self::failures`]).
     pub fn from_samples(
         parameterization: Parameterization,
         samples: Vec<Vec<f64>>,
+        speeds_rpm: &[f64],
+        options: SolverOptions,
+        observer: &dyn Observer,
+    ) -> Result<Self> {
+        let n = samples.len();
+        Self::weighted(
+            parameterization,
+            samples,
+            vec![-(n as f64).ln(); n],
+            speeds_rpm,
+            options,
+            observer,
+        )
+    }
+
+    /// Paths with log weights `ln_weights` (normalized on use).
+    fn weighted(
+        parameterization: Parameterization,
+        samples: Vec<Vec<f64>>,
+        ln_weights: Vec<f64>,
         speeds_rpm: &[f64],
         options: SolverOptions,
         observer: &dyn Observer,
@@ -129,14 +164,15 @@ impl BoundaryEnsemble {
             .iter()
             .map(|t| parameterization.model(t))
             .collect::<Result<Vec<_>>>()?;
-        let n = samples.len();
         let mut ensemble = Self {
+            path_ids: (0..samples.len()).collect(),
             parameterization,
             samples,
             models,
             columns: Vec::new(),
-            ln_weights: vec![-(n as f64).ln(); n],
+            ln_weights,
             options,
+            failures: Vec::new(),
         };
         ensemble.add_speeds(speeds_rpm, observer)?;
         Ok(ensemble)
@@ -151,16 +187,15 @@ impl BoundaryEnsemble {
         options: SolverOptions,
         observer: &dyn Observer,
     ) -> Result<Self> {
-        let mut ensemble = Self::from_samples(
+        let total: f64 = set.weights().iter().sum();
+        Self::weighted(
             parameterization,
             set.samples().to_vec(),
+            set.weights().iter().map(|w| (w / total).ln()).collect(),
             speeds_rpm,
             options,
             observer,
-        )?;
-        let total: f64 = set.weights().iter().sum();
-        ensemble.ln_weights = set.weights().iter().map(|w| (w / total).ln()).collect();
-        Ok(ensemble)
+        )
     }
 
     /// Paths drawn from the posterior given the cuts made so far (004 Section 5): prior draws
@@ -245,7 +280,9 @@ impl BoundaryEnsemble {
         Self::from_samples(parameterization, samples, speeds_rpm, options, observer)
     }
 
-    /// Compute the paths at more speeds (those already present are kept).
+    /// Compute the paths at more speeds (those already present are kept). A path whose
+    /// boundary fails at one of them is dropped and counted ([`Self::failures`]); it is an
+    /// error only when no path is left, or for invalid options and a cancel.
     pub fn add_speeds(&mut self, speeds_rpm: &[f64], observer: &dyn Observer) -> Result<()> {
         let mut new: Vec<f64> = speeds_rpm
             .iter()
@@ -257,24 +294,67 @@ impl BoundaryEnsemble {
         if new.is_empty() {
             return Ok(());
         }
+        // options are checked once, so that a bad option is an error, not every path's failure
+        self.options.boundary.validate()?;
         let done = std::sync::atomic::AtomicUsize::new(0);
         let total = self.models.len();
         let grid = self.parameterization.nominal();
-        let per_path: Vec<Vec<LobePoint>> = self
+        let rows: Vec<PathRow> = self
             .models
             .par_iter()
             .map(|m| {
-                // a failed path is an error here: the paths' probabilities and the value of
-                // information are defined over every path
-                let row = chatter_progress::check(observer)
+                let row = match chatter_progress::check(observer)
                     .map_err(UpdatingError::from)
                     .and_then(|()| boundary_of(&self.options, m, Some(grid), &new))
-                    .and_then(|points| points.into_iter().collect::<Result<Vec<_>>>());
+                {
+                    Err(e) => Err((None, e)),
+                    Ok(points) => points
+                        .into_iter()
+                        .zip(&new)
+                        .map(|(point, &s)| point.map_err(|e| (Some(s), e)))
+                        .collect(),
+                };
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 observer.steps_done(k, total);
                 row
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect();
+        // paths skipped after a cancel would otherwise read as failures
+        chatter_progress::check(observer)?;
+        self.add_rows(&new, rows)
+    }
+
+    /// Add the columns of `new` speeds from one row per path; drop the failed paths.
+    fn add_rows(&mut self, new: &[f64], rows: Vec<PathRow>) -> Result<()> {
+        let keep: Vec<bool> = rows.iter().map(|r| r.is_ok()).collect();
+        let before = self.failures.len();
+        let mut per_path = Vec::with_capacity(rows.len());
+        for (row, &id) in rows.into_iter().zip(&self.path_ids) {
+            match row {
+                Ok(points) => per_path.push(points),
+                Err((speed_rpm, e)) => {
+                    self.failures.push(SampleFailure::new(id, speed_rpm, &e));
+                }
+            }
+        }
+        if per_path.is_empty() {
+            return Err(UpdatingError::InvalidInput {
+                field: "paths",
+                message: format!(
+                    "the stability boundary of every path failed; the first failure: {}",
+                    self.failures.get(before).map_or("", |f| f.message.as_str())
+                ),
+            });
+        }
+        if keep.contains(&false) {
+            retain_kept(&mut self.path_ids, &keep);
+            retain_kept(&mut self.samples, &keep);
+            retain_kept(&mut self.models, &keep);
+            retain_kept(&mut self.ln_weights, &keep);
+            for column in &mut self.columns {
+                retain_kept(&mut column.points, &keep);
+            }
+        }
         for (j, &speed_rpm) in new.iter().enumerate() {
             self.columns.push(Column {
                 speed_rpm,
@@ -284,6 +364,12 @@ impl BoundaryEnsemble {
         self.columns
             .sort_by(|a, b| a.speed_rpm.total_cmp(&b.speed_rpm));
         Ok(())
+    }
+
+    /// The paths dropped because their boundary failed (index among the samples the ensemble
+    /// was built from, the speed, the kind and the message), in the order they failed.
+    pub fn failures(&self) -> &[SampleFailure] {
+        &self.failures
     }
 
     fn column_index(&self, speed_rpm: f64) -> Option<usize> {
@@ -326,7 +412,8 @@ impl BoundaryEnsemble {
 
     /// The paths' boundaries at the grid's speeds ([`Self::speeds_rpm`]) with their current
     /// probabilities ([`Self::probabilities`]), as [`SampledBoundaries`] (limits in mm, infinite
-    /// where the path has no boundary below the depth ceiling).
+    /// where the path has no boundary below the depth ceiling). Its failures are the dropped
+    /// paths ([`Self::failures`]), which have no row.
     pub fn boundaries(&self) -> Result<SampledBoundaries> {
         let rows = |f: fn(&LobePoint) -> f64| -> Vec<Vec<f64>> {
             (0..self.samples.len())
@@ -339,6 +426,7 @@ impl BoundaryEnsemble {
             rows(|p| p.chatter_hz),
         )?
         .with_probabilities(self.probabilities())
+        .map(|b| b.with_failures(self.failures.clone()))
     }
 
     /// Path probabilities P_i (sum 1).
@@ -564,6 +652,12 @@ impl BoundaryEnsemble {
     }
 }
 
+/// Keep the entries of `values` whose `keep` flag is set (one flag per entry, in order).
+fn retain_kept<T>(values: &mut Vec<T>, keep: &[bool]) {
+    let mut flags = keep.iter();
+    values.retain(|_| flags.next().copied().unwrap_or(true));
+}
+
 /// sup{b : P_s(b) >= p_test} for one speed, just below the limit of the path where the
 /// cumulative weight of deeper paths falls under p_test (P_s(b) = weight of paths with limit > b);
 /// None when P_s < p_test already at depth 0.
@@ -679,6 +773,68 @@ mod tests {
         e.update(&off, &kernel).unwrap();
         assert_eq!(e.speeds_rpm(), vec![2100.0, 2200.0, 2400.0]);
         assert!(e.moments(3).is_err());
+    }
+
+    /// Injected solver failures (no convergence for paths 7 and 20 at a new speed): the two
+    /// paths are dropped and counted, the others keep their columns and share the probability,
+    /// and P_s is over them; with every path failing, the ensemble says so.
+    #[test]
+    fn a_failed_path_is_dropped_and_counted_not_read_as_stable() {
+        use crate::sampled::FailureKind;
+        use chatter_stability::StabilityError;
+        let mut e = small();
+        let before = e.boundaries().unwrap();
+        let samples = e.samples().to_vec();
+        let failed = || {
+            UpdatingError::Stability(StabilityError::NoConvergence {
+                solver: "fdm",
+                detail: "injected".into(),
+            })
+        };
+        // path i has its limit at 1 + i / 40 mm at 3000 rpm
+        let rows: Vec<PathRow> = (0..40)
+            .map(|i| match i {
+                7 | 20 => Err((Some(3000.0), failed())),
+                _ => Ok(vec![LobePoint {
+                    speed_rpm: 3000.0,
+                    depth_m: 1e-3 * (1.0 + i as f64 / 40.0),
+                    chatter_hz: 500.0,
+                }]),
+            })
+            .collect();
+        e.add_rows(&[3000.0], rows).unwrap();
+        assert_eq!(e.len(), 38);
+        let kept = |i: &usize| ![7, 20].contains(i);
+        assert_eq!(e.failures().len(), 2);
+        for (f, i) in e.failures().iter().zip([7, 20]) {
+            assert_eq!((f.sample, f.speed_rpm), (i, Some(3000.0)));
+            assert_eq!(f.kind, FailureKind::Numerical);
+        }
+        let want: Vec<Vec<f64>> = (0..40).filter(kept).map(|i| samples[i].clone()).collect();
+        assert_eq!(e.samples(), want.as_slice());
+        assert!(
+            e.probabilities()
+                .iter()
+                .all(|p| (p - 1.0 / 38.0).abs() < 1e-15)
+        );
+        // the old columns stay aligned with their paths
+        let after = e.boundaries().unwrap();
+        let old: Vec<f64> = (0..40)
+            .filter(kept)
+            .map(|i| before.limits_mm[i][0])
+            .collect();
+        let now: Vec<f64> = after.limits_mm.iter().map(|l| l[0]).collect();
+        assert_eq!(now, old);
+        assert_eq!(after.failures.len(), 2);
+        // P_s at 1.5 mm: paths 21..=39 lie above, 19 of the 38 left
+        let ps = e.probability_of_stability(3000.0, 1.5e-3).unwrap();
+        assert!((ps - 0.5).abs() < 1e-12, "{ps}");
+        let every: Vec<PathRow> = (0..38).map(|_| Err((None, failed()))).collect();
+        let error = e.add_rows(&[3500.0], every).unwrap_err().to_string();
+        assert!(
+            error.contains("every path failed") && error.contains("injected"),
+            "{error}"
+        );
     }
 
     #[test]

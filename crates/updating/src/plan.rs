@@ -115,6 +115,9 @@ pub struct PlanOutcome {
     pub best_stable_mrr_cm3_per_min: Option<f64>,
     /// Kish effective number of samples after the updates.
     pub effective_samples: f64,
+    /// Sampled paths dropped because their stability boundary failed (never read as stable or
+    /// unstable; `boundaries.failures` names them).
+    pub failed_paths: usize,
     /// The sampled boundaries after the updates (written as CSV by `chatter plan
     /// --boundaries-out`; not in the JSON).
     #[serde(skip)]
@@ -330,6 +333,7 @@ pub fn plan_next_cut(
         posterior_sd: moments.iter().map(|m| m.1).collect(),
         best_stable_mrr_cm3_per_min: best_stable,
         effective_samples: ensemble.effective_sample_size(),
+        failed_paths: ensemble.failures().len(),
         boundaries: ensemble.boundaries()?,
     })
 }

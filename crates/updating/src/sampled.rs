@@ -300,6 +300,19 @@ pub fn boundary_of(
         .collect())
 }
 
+impl SampleFailure {
+    /// The failure of sample `sample` (at `speed_rpm`, or None for the whole sample) by
+    /// `error`, classified by [`failure_kind`].
+    pub(crate) fn new(sample: usize, speed_rpm: Option<f64>, error: &UpdatingError) -> Self {
+        Self {
+            sample,
+            speed_rpm,
+            kind: failure_kind(error),
+            message: error.to_string(),
+        }
+    }
+}
+
 /// Which failure an error is: no convergence is numerical; the rest (no valid model, an
 /// unstable structure, a model the method does not apply to) is the sample's.
 fn failure_kind(error: &UpdatingError) -> FailureKind {
@@ -328,12 +341,7 @@ pub fn sample_boundaries(
     // options are checked once, so that a bad option is an error and not S x speeds failures
     options.boundary.validate()?;
     let done = AtomicUsize::new(0);
-    let failed = |sample: usize, speed_rpm: Option<f64>, error: &UpdatingError| SampleFailure {
-        sample,
-        speed_rpm,
-        kind: failure_kind(error),
-        message: error.to_string(),
-    };
+    let failed = SampleFailure::new;
     // per sample: (limit mm, chatter Hz) per speed, and its failures
     type Row = (Vec<(f64, f64)>, Vec<SampleFailure>);
     let rows: Vec<Row> = thetas

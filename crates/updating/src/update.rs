@@ -126,6 +126,51 @@ pub struct UpdateResult {
     pub pole_table: Vec<PoleComparison>,
 }
 
+/// A posterior's `summary.json`: what `chatter update` writes beside `posterior.csv` and what
+/// the bands read back (`chatter_uncertainty::parameters::ParameterDistribution::from_posterior_dir`).
+/// A reader needs only the names and the moments; the classes, the selected alpha, the pile-ups
+/// and the surrogate report are written for people and skipped when read. The fields are in
+/// the file's key order (alphabetical).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PosteriorSummary {
+    /// Every model class (written only).
+    #[serde(skip_deserializing)]
+    pub classes: Vec<ClassSummary>,
+    /// Sampled parameter names, in the order of the mean and the covariance.
+    pub parameter_names: Vec<String>,
+    /// Posterior covariance, row by row.
+    pub posterior_covariance: Vec<Vec<f64>>,
+    /// Posterior mean.
+    pub posterior_mean: Vec<f64>,
+    /// Parameters whose posterior piles against a bound of its prior (written only).
+    #[serde(skip_deserializing)]
+    pub prior_bound_pileups: Vec<crate::prior_bounds::BoundPileup>,
+    /// The selected alpha (written only).
+    #[serde(skip_deserializing)]
+    pub selected_alpha: Option<f64>,
+    /// The surrogate's errors, when one replaced the exact likelihood (written only).
+    #[serde(skip_deserializing)]
+    pub surrogate: Option<SurrogateReport>,
+}
+
+impl PosteriorSummary {
+    /// The summary of an update.
+    pub fn of(result: &UpdateResult) -> Self {
+        let c = &result.posterior_covariance;
+        Self {
+            classes: result.classes.clone(),
+            parameter_names: result.parameter_names.clone(),
+            posterior_covariance: (0..c.nrows())
+                .map(|i| (0..c.ncols()).map(|j| c[(i, j)]).collect())
+                .collect(),
+            posterior_mean: result.posterior_mean.clone(),
+            prior_bound_pileups: result.prior_bound_pileups.clone(),
+            selected_alpha: result.selected_alpha,
+            surrogate: result.surrogate,
+        }
+    }
+}
+
 /// An identified pole beside the model's prediction before and after updating.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct PoleComparison {

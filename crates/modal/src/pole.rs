@@ -5,7 +5,7 @@
 //! zeta (e.g. 000 Eq. 6 and 25, 002 Section 2.1 for lambda = ln(mu) / tau of a multiplier).
 //!
 //! ```
-//! use chatter_dynamics::pole::{pole_frequency_damping, pole_from_frequency_damping};
+//! use chatter_modal::pole::{pole_frequency_damping, pole_from_frequency_damping};
 //! let lambda = pole_from_frequency_damping(2473.0, 0.02);
 //! let (f, zeta) = pole_frequency_damping(lambda);
 //! assert!((f - 2473.0).abs() < 1e-9 && (zeta - 0.02).abs() < 1e-15);
