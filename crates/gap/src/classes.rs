@@ -23,9 +23,10 @@ use crate::error::{GapError, Result};
 use crate::variant::{Variant, recalibrated};
 use chatter_bayes::prior::{IndependentPrior, Marginal, Prior};
 use chatter_dynamics::{ModalModel, Mode, ModeShape};
+use chatter_stability::boundary::BoundaryOptions;
 use chatter_stability::boundary::dominant_mode_frequency_hz;
+use chatter_stability::prepared::Method;
 use chatter_stability::process_damping::{average_normal_projector, damping_ratio_slope_per_m};
-use chatter_stability::zero_order::zoa_limiting_depth;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -215,9 +216,10 @@ impl Nominal {
             Some(d) => {
                 // the lowest zero-order limit over the observed speeds (a prior scale only)
                 let bare = model.with_process_damping(None)?;
+                let zero_order = Method::Zoa.prepare(&bare, &BoundaryOptions::default()).ok();
                 let b_min = speeds
                     .iter()
-                    .filter_map(|&s| zoa_limiting_depth(&bare, s).ok())
+                    .filter_map(|&s| zero_order.as_ref()?.limiting_depth(s).ok())
                     .map(|p| p.depth_m)
                     .fold(f64::INFINITY, f64::min);
                 // every mode gets up to SPAN times its own damping: the least affected sets C_max

@@ -18,8 +18,8 @@ use chatter_bayes::tmcmc::{
 };
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_progress::Observer;
-use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::boundary::BoundaryOptions;
+use chatter_stability::prepared::Method;
 use rand::SeedableRng;
 use rayon::prelude::*;
 use serde::{Serialize, Serializer};
@@ -547,15 +547,8 @@ impl Diagnosis {
         let depth = |v: &Variant, speed: f64, u: f64| -> f64 {
             v.at(None, speed, u)
                 .ok()
-                .and_then(|m| {
-                    limiting_depth(
-                        &Discretization::full(),
-                        &m,
-                        speed,
-                        &BoundaryOptions::default(),
-                    )
-                    .ok()
-                })
+                .and_then(|m| Method::Fdm.prepare(&m, &BoundaryOptions::default()).ok())
+                .and_then(|solver| solver.limiting_depth(speed).ok())
                 .map_or(f64::NAN, |p| p.depth_m * 1e3)
         };
         speeds_rpm
