@@ -1544,7 +1544,7 @@ fn detect_estimates_the_speed_of_a_sound_clip() {
         "{note}"
     );
     // the chatter clip: its background before and after the cut is a reference stretch, and
-    // the cut's dominant line is the chatter (chatter_oma tests/detection.rs)
+    // the cut's dominant line is the chatter (tests/oma_detection.rs)
     let Some(clip) = real_data("milling_chatter_record/combined_chatter6567.mp3") else {
         return;
     };

@@ -610,7 +610,7 @@ fn noise_is_stable_and_bad_options_are_errors() {
 fn real_record_test255_is_chatter() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/real/milling_chatter_record/test255_accelY.csv"
+        "/../../shared/data/real/milling_chatter_record/test255_accelY.csv"
     );
     if !std::path::Path::new(path).exists() {
         eprintln!("skipped: {path} is absent");
@@ -682,7 +682,7 @@ fn real_record_test255_is_chatter() {
 fn real_mp3_clips_with_the_speed_unknown() {
     let dir = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/real/milling_chatter_record/"
+        "/../../shared/data/real/milling_chatter_record/"
     );
     for (file, seconds) in [
         ("combined_chatter6567.mp3", 63.2),

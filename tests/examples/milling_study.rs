@@ -6,7 +6,7 @@
 //! Truth: the dominant multiplier of the first-order full discretization at 4x its automatic
 //! resolution (`chatter_stability`), independent of the simulator and of the OMA.
 //!
-//! `cargo run --release -p chatter-oma --example milling_study -- [--speeds 12] [--seconds 8]
+//! `cargo run --release -p chatter-integration --example milling_study -- [--speeds 12] [--seconds 8]
 //! [--poles]`: one line per record (speed, depth ratio, truth kind, |mu|, chatter frequency,
 //! detection verdict, flip evidence); with `--poles`, lifted OMA on 16 s stable records against
 //! the truth's multiplier.
