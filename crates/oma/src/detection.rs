@@ -39,9 +39,9 @@
 //! - the line stands [`MIN_LINE_TO_FLOOR_DB`] above the floor, the median density of the
 //!   non-synchronous bins (so that a record of noise is never chatter).
 //!
-//! The margin reported is the larger of the two threshold distances (positive: chatter). On simulated lobe diagrams
-//! (see the workspace's `tests/oma_detection.rs`) V was at most 0.19 in chatter and between 0.37 and 0.94 in stable
-//! cuts; on the real chatter record `test255_accelY.csv` (intermittent chatter) it is 2.0.
+//! The margin reported is the larger of the two threshold distances (positive: chatter). On
+//! simulated lobe diagrams (see `tests/oma_detection.rs`) V was at most 0.19 in chatter and
+//! between 0.37 and 0.94 in stable cuts; on the real chatter record `test255_accelY.csv` (intermittent chatter) it is 2.0.
 //! Also reported: the line's power against the synchronous (forced) power, E_line / E_sync, and
 //! against everything else in the band, both less the floor, in dB.
 //!
@@ -69,7 +69,7 @@
 //! `milling_study` of the workspace's tests package: 4 teeth, 30 %, 72 simulated records):
 //! stable records reach +10.0 dB, its
 //! three flip-chatter records +22.6 to +25.0 dB; it is checked on another machine (seed 001's,
-//! the workspace's `tests/oma_detection.rs`). With two teeth there is no runout-only harmonic and flip chatter is
+//! `tests/oma_detection.rs`). With two teeth there is no runout-only harmonic and flip chatter is
 //! not judged; a record that is chatter by the main criterion keeps its line. Judged on the whole
 //! record only, not window by window.
 //!
@@ -113,14 +113,14 @@
 //! less than 0 dB over the rest. A stationary record (a simulated cut, a cut recorded whole)
 //! has no reference stretch and is judged by V alone.
 //!
-//! On the chatter clip `combined_chatter6567.mp3` (63 s; the workspace's `tests/oma_detection.rs`) the cut lasts
+//! On the chatter clip `combined_chatter6567.mp3` (63 s; `tests/oma_detection.rs`) the cut lasts
 //! from about 5 to 18 s: its windows are 5-10 dB louder than the rest, whose stationary lines
 //! (2329.9, 1770.7, 869.4 Hz: the same before and after the cut) V took for chatter; the
 //! chatter line 1067-1077 Hz carries +2.0, +3.9 and +1.0 dB over the rest of the band in three
 //! windows from 8.9 s (V 0.67, 0.62, 1.92 there). The thresholds were set with this clip in view
 //! (the only real record with a reference stretch in the project). The no-chatter clip
-//! (contrast 0.6 dB) and the built records of the workspace's `tests/oma_detection.rs` (contrast at most 0.1 dB, also
-//! with a limit cycle in part of the record) have none; the simulator sweeps' 4 s records are
+//! (contrast 0.6 dB) and the built records of `tests/oma_detection.rs` (contrast at most 0.1
+//! dB, also with a limit cycle in part of the record) have none; the simulator sweeps' 4 s records are
 //! judged whole.
 
 use crate::error::{OmaError, Result};

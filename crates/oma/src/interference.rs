@@ -52,7 +52,7 @@
 //! 15 lines at df = 1.2 Hz, f_m = 50 Hz); 4 of the first 12 multiples by chance then has
 //! probability about C(12, 4) p^4 = 8e-5 per independent candidate (about 20 Hz / (0.8 df / 12)
 //! = 250 of them in 45-65 Hz). Validated: no comb found in any of the 64 simulated lobe-diagram
-//! records of the workspace's `tests/oma_detection.rs` (spindle harmonics, chatter and its sidebands, no hum).
+//! records of `tests/oma_detection.rs` (spindle harmonics, chatter and its sidebands, no hum).
 
 use crate::spectrum::refine_peak_hz;
 use serde::{Deserialize, Serialize};
