@@ -41,7 +41,8 @@
 //!
 //! The margin reported is the larger of the two threshold distances (positive: chatter). On
 //! simulated lobe diagrams (see `tests/oma_detection.rs`) V was at most 0.19 in chatter and
-//! between 0.37 and 0.94 in stable cuts; on the real chatter record `test255_accelY.csv` (intermittent chatter) it is 2.0.
+//! between 0.37 and 0.94 in stable cuts; on the real chatter record `test255_accelY.csv`
+//! (intermittent chatter) it is 2.0.
 //! Also reported: the line's power against the synchronous (forced) power, E_line / E_sync, and
 //! against everything else in the band, both less the floor, in dB.
 //!
