@@ -392,7 +392,7 @@ pub(crate) fn in_parallel(
 
 /// |mu| on a speed x depth grid (rows per speed), for contour plots; `observer` hears of each
 /// speed done and is polled before every cell
-/// ([`StabilityError::Cancelled`](crate::StabilityError::Cancelled)).
+/// ([`StabilityError::Cancelled`]).
 pub fn multiplier_grid<S: StabilitySolver + ?Sized>(
     solver: &S,
     model: &ModalModel,
