@@ -34,6 +34,23 @@ pub struct Cut {
     pub evidence: Option<CutEvidence>,
 }
 
+impl Cut {
+    /// A cut labelled stable or chatter by hand, with none of the optional fields (no chatter
+    /// frequency, order, immersion override, note or detection evidence).
+    pub fn labelled(speed_rpm: f64, depth_mm: f64, stable: bool) -> Self {
+        Self {
+            speed_rpm,
+            depth_mm,
+            stable,
+            chatter_hz: None,
+            sequence: None,
+            radial_immersion: None,
+            note: None,
+            evidence: None,
+        }
+    }
+}
+
 /// Why chatter detection called a cut stable or chatter: the strongest line that is not a
 /// harmonic of the spindle frequency and the statistics of its power (criterion and thresholds
 /// in `chatter_oma::detection`).

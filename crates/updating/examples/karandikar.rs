@@ -154,16 +154,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?;
         for i in 1..=8 {
             let depth_mm = 0.5 * i as f64;
-            cuts.push(Cut {
-                speed_rpm: speed,
+            cuts.push(Cut::labelled(
+                speed,
                 depth_mm,
-                stable: depth_mm * 1e-3 < limit.depth_m,
-                chatter_hz: None,
-                sequence: None,
-                radial_immersion: None,
-                note: None,
-                evidence: None,
-            });
+                depth_mm * 1e-3 < limit.depth_m,
+            ));
         }
     }
     let rss = karandikar::rss_process_damping(&model, &cuts, 0.5e5, 10e5)?;

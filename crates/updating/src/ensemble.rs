@@ -530,16 +530,7 @@ impl BoundaryEnsemble {
             return (ps, 0.0);
         }
         let reduction = |stable: bool| -> f64 {
-            let cut = Cut {
-                speed_rpm: column.speed_rpm,
-                depth_mm: depth_m * 1e3,
-                stable,
-                chatter_hz: None,
-                sequence: None,
-                radial_immersion: None,
-                note: None,
-                evidence: None,
-            };
+            let cut = Cut::labelled(column.speed_rpm, depth_m * 1e3, stable);
             let w: Vec<f64> = p
                 .iter()
                 .zip(&column.points)
@@ -738,16 +729,7 @@ mod tests {
             .map(|i| i as f64 * 0.01)
             .find(|d| e.probability_of_stability(2100.0, d * 1e-3).unwrap() <= 0.5)
             .unwrap();
-        let cut = Cut {
-            speed_rpm: 2100.0,
-            depth_mm: median_mm,
-            stable: false,
-            chatter_hz: None,
-            sequence: None,
-            radial_immersion: None,
-            note: None,
-            evidence: None,
-        };
+        let cut = Cut::labelled(2100.0, median_mm, false);
         let kernel = CutKernel {
             sigma_depth_m: 0.02e-3,
             sigma_chatter_hz: None,

@@ -739,16 +739,7 @@ mod tests {
             .unwrap();
         let mut obs = Observations::default();
         for (depth_mm, stable) in [(0.5, true), (1.0, false)] {
-            obs.cuts.push(Cut {
-                speed_rpm: 10_985.0,
-                depth_mm,
-                stable,
-                chatter_hz: None,
-                sequence: None,
-                radial_immersion: None,
-                note: None,
-                evidence: None,
-            });
+            obs.cuts.push(Cut::labelled(10_985.0, depth_mm, stable));
         }
         let options = SamplerOptions {
             sampler: Sampler::Itmcmc,
@@ -810,16 +801,7 @@ mod tests {
         let model = examples::ebrahimi_2025_milling();
         let mut obs = Observations::default();
         for (depth_mm, stable) in [(0.3, true), (0.9, false)] {
-            obs.cuts.push(Cut {
-                speed_rpm: 2100.0,
-                depth_mm,
-                stable,
-                chatter_hz: None,
-                sequence: None,
-                radial_immersion: None,
-                note: None,
-                evidence: None,
-            });
+            obs.cuts.push(Cut::labelled(2100.0, depth_mm, stable));
         }
         let settings = UpdateSettings {
             parameters: Some(vec![ModelParameter::KnNPerMm2]),

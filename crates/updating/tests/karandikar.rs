@@ -61,16 +61,7 @@ impl Machine {
             .unwrap()
             .depth_m
         });
-        Cut {
-            speed_rpm,
-            depth_mm,
-            stable: depth_mm * 1e-3 < limit,
-            chatter_hz: None,
-            sequence: None,
-            radial_immersion: None,
-            note: None,
-            evidence: None,
-        }
+        Cut::labelled(speed_rpm, depth_mm, depth_mm * 1e-3 < limit)
     }
 }
 

@@ -61,16 +61,7 @@ fn rss_recovers_the_process_damping_coefficient() {
         .depth_m
             * 1e3;
         for (depth_mm, stable) in [(limit - 0.05, true), (limit + 0.05, false)] {
-            cuts.push(Cut {
-                speed_rpm: speed,
-                depth_mm,
-                stable,
-                chatter_hz: None,
-                sequence: None,
-                radial_immersion: None,
-                note: None,
-                evidence: None,
-            });
+            cuts.push(Cut::labelled(speed, depth_mm, stable));
         }
     }
     let fit = karandikar::rss_process_damping(&model, &cuts, 0.5e5, 10e5).unwrap();

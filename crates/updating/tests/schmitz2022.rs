@@ -81,16 +81,7 @@ fn proposed_cut_is_on_the_contour_of_the_exported_boundaries_and_the_cap_stops()
     let cuts = Observations {
         cuts: [cut.depth_mm, 0.5 * cut.depth_mm]
             .iter()
-            .map(|&depth_mm| Cut {
-                speed_rpm: cut.speed_rpm,
-                depth_mm,
-                stable: true,
-                chatter_hz: None,
-                sequence: None,
-                radial_immersion: None,
-                note: None,
-                evidence: None,
-            })
+            .map(|&depth_mm| Cut::labelled(cut.speed_rpm, depth_mm, true))
             .collect(),
         ..Observations::default()
     };
@@ -143,16 +134,8 @@ fn update_with_the_correlated_prior_matches_importance_reweighted_prior_draws() 
     // three cuts at 10 985 rpm (the paper's first test speed): stable at 2.5 mm, chatter at
     // 4.5 mm and a stable one at 3 mm; they speak to the limit at one speed, not to how the
     // modal parameters co-vary
-    let cut = |speed_rpm: f64, depth_mm: f64, stable: bool| Cut {
-        speed_rpm,
-        depth_mm,
-        stable,
-        chatter_hz: None,
-        sequence: None,
-        radial_immersion: None,
-        note: None,
-        evidence: None,
-    };
+    let cut =
+        |speed_rpm: f64, depth_mm: f64, stable: bool| Cut::labelled(speed_rpm, depth_mm, stable);
     let observations = Observations {
         cuts: vec![
             cut(10_985.0, 0.65, true),
