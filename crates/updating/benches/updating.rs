@@ -127,16 +127,7 @@ fn cut_likelihood(c: &mut Criterion) {
     .unwrap_or_else(|e| panic!("{e}"));
     let cuts: Vec<Cut> = [(300.0, 2.5, true), (700.0, 1.5, false), (1100.0, 1.2, true)]
         .into_iter()
-        .map(|(speed_rpm, depth_mm, stable)| Cut {
-            speed_rpm,
-            depth_mm,
-            stable,
-            chatter_hz: None,
-            sequence: None,
-            radial_immersion: None,
-            evidence: None,
-            note: None,
-        })
+        .map(|(speed_rpm, depth_mm, stable)| Cut::labelled(speed_rpm, depth_mm, stable))
         .collect();
     let theta = [2150.0, 1040.0, 2.8e5];
     let mut group = c.benchmark_group("cut_likelihood_003");
