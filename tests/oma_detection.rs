@@ -399,6 +399,30 @@ fn built_records_with_and_without_a_limit_cycle() {
     }
 }
 
+/// A limit cycle far above the forced harmonics, 0.4 % below a harmonic of the nominal speed's
+/// fundamental (15 x 80 Hz x 0.996 = 1195.2 Hz): within the default 0.5 % speed tolerance a
+/// fundamental of 79.68 Hz puts its 15th multiple on the line, and a refinement over every
+/// harmonic at once took it and read the line as synchronous (a time-domain lathe at 918 rpm
+/// chattering at 730.6 Hz with 46 um RMS was called stable). Refined on the first ten
+/// harmonics first, the line is chatter at its frequency (the old refinement gave 79.87 Hz and
+/// `stable` on seed 0).
+#[test]
+fn a_line_near_a_harmonic_does_not_pull_the_fundamental() {
+    for seed in 0..3 {
+        let d = detect(
+            &built_record(Some(1195.2), None, seed),
+            &DetectionOptions::new(80.0),
+        )
+        .unwrap();
+        assert_eq!(d.verdict, Verdict::Chatter, "{:?}", d.evidence);
+        eprintln!(
+            "seed {seed}: fundamental {:.3} Hz",
+            d.evidence.fundamental_hz
+        );
+        assert!((d.chatter_hz.unwrap() - 1195.2).abs() <= d.evidence.resolution_hz);
+    }
+}
+
 /// Mains hum: the built records above with a 50.02 Hz or 59.97 Hz comb whose third harmonic is
 /// the strongest line besides the forced ones. A mains line has a constant amplitude, so left in
 /// it would be called chatter in a stable record (checked with the search off) and would hide the

@@ -5,18 +5,20 @@
 //!   boundary (from the Floquet multiplier at the cut itself) chatters with probability
 //!   p = lapse + (1 - 2 lapse) Phi(d / w): a probit with width w (label noise near the boundary,
 //!   and the discretization's error in depth) and a small lapse rate for outright mislabels.
-//! - A chatter frequency f is Gaussian around the frequency of the dominant multiplier at the
-//!   cut's own depth with standard deviation s_c; for milling the residual is folded over the
-//!   tooth-passing harmonics and taken against the nearer of the images k f_tp +- f_mu
-//!   (a wrapped normal).
+//! - A chatter frequency f is a mixture over the branches a chattering cut may vibrate on
+//!   ([`crate::predict`]): for turning each branch is uniform between its axis crossing and its
+//!   root at the cut's depth, blurred by N(0, s_c^2); for milling it is Gaussian around the
+//!   dominant multiplier's frequency at the cut's depth with standard deviation s_c, the residual
+//!   folded over the tooth-passing harmonics and taken against the nearer of the images
+//!   k f_tp +- f_mu (a wrapped normal).
 //! - A pole's frequency and damping ratio are Gaussian around the predicted pole with the
 //!   observation's standard deviations (or the defaults); a milling pole's principal frequency is
 //!   folded into [0, f_tp / 2] like the data.
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::predict::{CutPrediction, PredictedPole, Prediction};
-use chatter_bayes::special::{log_sum_exp, normal_cdf};
+use crate::predict::{ChatterBranch, CutPrediction, PredictedPole, Prediction};
+use chatter_bayes::special::{erfc, log_sum_exp, normal_cdf};
 use serde::{Deserialize, Serialize};
 
 /// The noise assumed in the observations. Defaults in [`NoiseModel::default`].
@@ -203,24 +205,53 @@ impl Terms {
     }
 }
 
-/// ln of the density of a chatter frequency `f` given the predicted `predicted` and the fold:
-/// milling folds the residual over the tooth-passing harmonics and takes the nearer of the
-/// images k f_tp + f_mu and k f_tp - f_mu; turning compares directly.
-fn ln_chatter_density(f: f64, predicted: f64, s: f64, fold: Option<f64>) -> f64 {
+/// ln of the density of a chatter frequency `f` on `branch` with spread `s`: milling folds the
+/// residual against the branch's frequency over the tooth-passing harmonics and takes the nearer
+/// of the images k f_tp + f_mu and k f_tp - f_mu; turning takes f uniform between the branch's
+/// axis crossing and its root at the cut's depth, blurred by N(0, s^2).
+fn ln_chatter_density(f: f64, branch: &ChatterBranch, s: f64, fold: Option<f64>) -> f64 {
     match fold {
         Some(ft) => {
-            let r = chatter_residual(f, predicted, Some(ft));
+            let r = chatter_residual(f, branch.at_depth_hz, Some(ft));
             ln_wrapped_normal(r, s, ft)
         }
-        None => ln_normal(f - predicted, s),
+        None => ln_blurred_segment(f, branch.crossing_hz, branch.at_depth_hz, s),
     }
 }
 
-/// The residual of an observed chatter frequency against the nearest frequency `q` admits
-/// ([`CutPrediction::chatter_candidates_hz`]).
+/// ln of the density at `f` of a value uniform between `a` and `b` plus N(0, s^2) noise:
+/// ln[(Phi((f - lo) / s) - Phi((f - hi) / s)) / (hi - lo)], the normal density when the segment
+/// is shorter than s / 1000. The difference is taken between upper tails (f above the
+/// segment's middle) or lower tails, so that it keeps its relative accuracy far outside.
+fn ln_blurred_segment(f: f64, a: f64, b: f64, s: f64) -> f64 {
+    let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+    let width = hi - lo;
+    if width < 1e-3 * s {
+        return ln_normal(f - 0.5 * (lo + hi), s);
+    }
+    let tail = |z: f64| 0.5 * erfc(z / std::f64::consts::SQRT_2);
+    let mass = if f >= 0.5 * (lo + hi) {
+        tail((f - hi) / s) - tail((f - lo) / s)
+    } else {
+        tail((lo - f) / s) - tail((hi - f) / s)
+    };
+    mass.max(f64::MIN_POSITIVE).ln() - width.ln()
+}
+
+/// The residual of an observed chatter frequency against the nearest frequency the branches of
+/// `q` admit (0 inside a turning branch's segment).
 pub(crate) fn nearest_chatter_residual(f: f64, q: &CutPrediction, fold: Option<f64>) -> f64 {
-    q.chatter_candidates_hz()
-        .map(|p| chatter_residual(f, p, fold))
+    q.chatter_branches()
+        .map(|b| match fold {
+            Some(_) => chatter_residual(f, b.at_depth_hz, fold),
+            None => {
+                let (lo, hi) = (
+                    b.crossing_hz.min(b.at_depth_hz),
+                    b.crossing_hz.max(b.at_depth_hz),
+                );
+                f - f.clamp(lo, hi)
+            }
+        })
         .min_by(|a, b| a.abs().total_cmp(&b.abs()))
         .unwrap_or(f64::NAN)
 }
@@ -268,10 +299,12 @@ pub(crate) fn terms(prediction: &Prediction, data: &Dataset, noise: &NoiseModel)
             match predicted {
                 Some(q) => {
                     let ln: Vec<f64> = q
-                        .chatter_candidates_hz()
-                        .map(|p| ln_chatter_density(f, p, data.chatter_std_hz, fold))
+                        .chatter_branches()
+                        .map(|b| {
+                            b.weight.ln() + ln_chatter_density(f, b, data.chatter_std_hz, fold)
+                        })
                         .collect();
-                    let ln_mixture = log_sum_exp(&ln) - (ln.len() as f64).ln();
+                    let ln_mixture = log_sum_exp(&ln);
                     with_lapse(ln_mixture, uniform, noise.lapse)
                 }
                 None => uniform,

@@ -15,14 +15,22 @@
 //!   log-depth distance of the cut to the boundary is d = ln((ln|mu| - ln|mu_0|) / -ln|mu_0|).
 //!   d = 0 exactly where |mu| = 1; away from it d is approximate, which only shapes the label
 //!   noise.
-//! - a **chattering cut**'s frequency is that of the dominant multiplier at the cut's own depth
-//!   (not at the boundary): the principal frequency arg(mu) / (2 pi tau) with its images
-//!   k / tau +- f_mu for milling; for turning Im lambda / 2 pi of any unstable root, an equal
-//!   mixture over the dominant root and up to three more (past the boundary several roots of a
-//!   chain are unstable, and a limit cycle with loss of contact may settle on any of them: on
-//!   time-domain simulations of the proving ground's lathe at |mu| 1.4-1.6 it settled 25-50 Hz
-//!   from the dominant root, on the root that crossed first; equal weights, so that a machine
-//!   with more unstable roots gains nothing from them on data that follow the dominant one).
+//! - a **chattering cut**'s frequency: for milling that of the dominant multiplier at the cut's
+//!   own depth (the principal frequency arg(mu) / (2 pi tau) with its images k / tau +- f_mu);
+//!   for turning a mixture over root branches (`ChatterBranch`), each a segment from the
+//!   frequency where the branch crosses the imaginary axis as the depth is lowered
+//!   ([`chatter_stability::frequency_domain::axis_crossings`]: the describing-function limit
+//!   cycle with loss of contact) to that of its root at the cut's depth (the linear growth, what
+//!   the exact-monodromy proving ground reports). Past the boundary several branches are
+//!   unstable, and time-domain simulations with loss of contact settle on the dominant branch or
+//!   on the branch that crossed first (the boundary's), about equally often (example
+//!   `chatter_frequency`: the lathe at 1.5x and 2.5x the limit, 10 speeds), between the
+//!   branch's crossing and its root at depth (60-70 % of the way to the latter, 1-4 Hz from
+//!   it at 720-760 Hz): weights 0.45 each (0.9 when they are one branch), 0.1 shared by the next
+//!   two unstable branches. Before this the frequency was an equal mixture over the four most
+//!   unstable roots at depth, and a limit cycle on the boundary's branch of a cut at |mu| 2.2
+//!   (36-56 Hz from the dominant root, the boundary's branch no longer among the four) was
+//!   absorbed by an extra mode.
 //! - an identified **pole** at a stable cut: for milling lambda = ln(mu) / tau of the dominant
 //!   multiplier, lifted over the tooth period (principal frequency |Im lambda| / 2 pi, damping
 //!   -Re lambda / |lambda|, as in 002); for turning the physical root (000 Eq. 6): the
@@ -49,7 +57,8 @@ use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
 use chatter_stability::frequency_domain::{
-    FrequencyDomain, dominant_and_unstable_poles, dominant_resonance_pole, mode_poles,
+    ClosedLoopPole, FrequencyDomain, axis_crossings, dominant_and_unstable_poles,
+    dominant_resonance_pole, mode_poles,
 };
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::multiplier::DominantMultiplier;
@@ -64,26 +73,48 @@ pub(crate) struct CutPrediction {
     /// ln|mu| without cutting.
     pub ln_modulus_free: f64,
     /// Predicted chatter frequency (Hz): principal (milling) or physical (turning), of the
-    /// dominant multiplier or root.
+    /// dominant multiplier or root at the cut's depth.
     pub chatter_hz: f64,
-    /// For turning, the frequencies (Hz) of the other unstable roots a limit cycle may settle
-    /// on (module docs), by decreasing growth rate; NaN where there are fewer.
-    pub other_chatter_hz: [f64; OTHER_ROOTS],
+    /// Where a chattering cut may vibrate (module docs), with their weights (summing to 1);
+    /// `None` in the unused slots. Milling: the dominant multiplier's frequency alone.
+    pub branches: [Option<ChatterBranch>; BRANCHES],
 }
 
-/// Most unstable roots besides the dominant one that a turning chatter frequency is mixed over.
-pub(crate) const OTHER_ROOTS: usize = 3;
+/// A root branch a chattering cut may vibrate on: between the frequency where the branch
+/// crosses the imaginary axis (the limit cycle with loss of contact) and that of its root at
+/// the cut's own depth (the linear growth).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ChatterBranch {
+    /// Frequency of the root at the cut's depth (Hz).
+    pub at_depth_hz: f64,
+    /// Frequency where the branch crosses the axis (Hz); `at_depth_hz` when not found.
+    pub crossing_hz: f64,
+    /// Mixture weight.
+    pub weight: f64,
+}
+
+impl ChatterBranch {
+    fn point(frequency_hz: f64, weight: f64) -> Self {
+        Self {
+            at_depth_hz: frequency_hz,
+            crossing_hz: frequency_hz,
+            weight,
+        }
+    }
+}
+
+/// Branches a turning chatter frequency is mixed over: the dominant one, the first to cross,
+/// and up to two more unstable ones.
+pub(crate) const BRANCHES: usize = 4;
+/// Weight of the dominant branch and of the first-crossed branch when they differ.
+const MAIN_WEIGHT: f64 = 0.45;
+/// Weight shared by the other unstable branches.
+const OTHER_WEIGHT: f64 = 0.1;
 
 impl CutPrediction {
-    /// The frequencies a chattering cut may show: the dominant one, then the other unstable
-    /// roots'.
-    pub fn chatter_candidates_hz(&self) -> impl Iterator<Item = f64> + '_ {
-        std::iter::once(self.chatter_hz).chain(
-            self.other_chatter_hz
-                .iter()
-                .copied()
-                .filter(|f| f.is_finite()),
-        )
+    /// The branches a chattering cut may show.
+    pub fn chatter_branches(&self) -> impl Iterator<Item = &ChatterBranch> + '_ {
+        self.branches.iter().flatten()
     }
 }
 
@@ -162,28 +193,87 @@ pub(crate) fn predict_cut(
     let model = variant.at(immersion, speed_rpm, u).ok()?;
     let tau = model.operation().delay_s(speed_rpm);
     let s = inference_solver(&model);
-    let mut other_chatter_hz = [f64::NAN; OTHER_ROOTS];
-    let (mu, chatter_hz) = if with_frequency && !milling(&model) {
+    let (mu, chatter_hz, branches) = if with_frequency && !milling(&model) {
         // one Newton pass for the dominant root (FrequencyDomain's multiplier) and the others
         let (dominant, others) = dominant_and_unstable_poles(&model, speed_rpm, depth_m).ok()?;
-        for (slot, p) in other_chatter_hz.iter_mut().zip(others) {
-            *slot = p.lambda.im / (2.0 * PI);
-        }
+        let mut roots = vec![dominant];
+        roots.extend(others);
         (
             DominantMultiplier::new((dominant.lambda * tau).exp(), tau),
-            dominant.lambda.im / (2.0 * PI),
+            hz(&dominant),
+            turning_branches(&model, speed_rpm, depth_m, &roots),
         )
     } else {
         let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
-        (mu, mu.principal_frequency_hz())
+        let f = mu.principal_frequency_hz();
+        let mut branches = [None; BRANCHES];
+        branches[0] = Some(ChatterBranch::point(f, 1.0));
+        (mu, f, branches)
     };
     let ln_modulus = mu.modulus().ln();
     ln_modulus.is_finite().then_some(CutPrediction {
         ln_modulus,
         ln_modulus_free: free_ln_modulus(&model, tau),
         chatter_hz,
-        other_chatter_hz,
+        branches,
     })
+}
+
+/// Im lambda / 2 pi (Hz).
+fn hz(p: &ClosedLoopPole) -> f64 {
+    p.lambda.im / (2.0 * PI)
+}
+
+/// The branches of a turning cut (module docs): `roots` are the dominant root then the other
+/// unstable ones by decreasing growth rate. The dominant branch and the branch that crosses the
+/// axis at the smallest depth (the boundary's) weigh [`MAIN_WEIGHT`] each (both when they are
+/// one), the next two unstable branches share [`OTHER_WEIGHT`]; without other branches the
+/// weights are renormalized.
+fn turning_branches(
+    model: &ModalModel,
+    speed_rpm: f64,
+    depth_m: f64,
+    roots: &[ClosedLoopPole],
+) -> [Option<ChatterBranch>; BRANCHES] {
+    let crossings = axis_crossings(model, speed_rpm, depth_m, roots).unwrap_or_default();
+    let branch = |i: usize, weight: f64| {
+        let at_depth_hz = hz(&roots[i]);
+        let crossing_hz = crossings
+            .get(i)
+            .copied()
+            .flatten()
+            .map_or(at_depth_hz, |(_, p)| hz(&p));
+        ChatterBranch {
+            at_depth_hz,
+            crossing_hz,
+            weight,
+        }
+    };
+    let first_crossed = crossings
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| c.map(|(width, _)| (i, width)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |(i, _)| i);
+    let mut chosen = vec![(0, MAIN_WEIGHT)];
+    if first_crossed != 0 {
+        chosen.push((first_crossed, MAIN_WEIGHT));
+    } else {
+        chosen[0].1 += MAIN_WEIGHT;
+    }
+    let others: Vec<usize> = (1..roots.len())
+        .filter(|&i| i != first_crossed)
+        .take(BRANCHES - chosen.len())
+        .collect();
+    for &i in &others {
+        chosen.push((i, OTHER_WEIGHT / others.len() as f64));
+    }
+    let total: f64 = chosen.iter().map(|c| c.1).sum();
+    let mut branches = [None; BRANCHES];
+    for (slot, (i, w)) in branches.iter_mut().zip(chosen) {
+        *slot = Some(branch(i, w / total));
+    }
+    branches
 }
 
 /// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).

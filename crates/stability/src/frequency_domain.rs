@@ -167,6 +167,28 @@ pub fn dominant_and_unstable_poles(
     ))
 }
 
+/// Where the branch of each of `poles` (closed-loop poles at `speed_rpm` and width `width_m`,
+/// e.g. the unstable ones of [`dominant_and_unstable_poles`]) crosses the imaginary axis as the
+/// width is lowered: the width (m) and the pole there, `None` for a pole that is not unstable
+/// or whose branch is lost ([`Characteristic::axis_crossing`]). A chattering cut with loss of
+/// contact settles near one of these frequencies (the describing-function limit cycle).
+pub fn axis_crossings(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+    poles: &[ClosedLoopPole],
+) -> Result<Vec<Option<(f64, ClosedLoopPole)>>> {
+    check_condition(speed_rpm, width_m)?;
+    let ch = Characteristic::new(model, speed_rpm)?;
+    Ok(poles
+        .iter()
+        .map(|p| {
+            ch.axis_crossing(p.lambda, width_m)
+                .map(|(a, l)| (a, ClosedLoopPole::new(l)))
+        })
+        .collect())
+}
+
 /// The error when no Newton start converges.
 fn no_root(speed_rpm: f64, width_m: f64) -> StabilityError {
     StabilityError::NoConvergence {
