@@ -57,8 +57,8 @@ use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
 use chatter_stability::frequency_domain::{
-    ClosedLoopPole, FrequencyDomain, axis_crossings, dominant_and_unstable_poles,
-    dominant_resonance_pole, mode_poles,
+    CHATTER_BRANCHES as BRANCHES, FrequencyDomain, chatter_branches, dominant_resonance_pole,
+    mode_poles,
 };
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::multiplier::DominantMultiplier;
@@ -102,14 +102,6 @@ impl ChatterBranch {
         }
     }
 }
-
-/// Branches a turning chatter frequency is mixed over: the dominant one, the first to cross,
-/// and up to two more unstable ones.
-pub(crate) const BRANCHES: usize = 4;
-/// Weight of the dominant branch and of the first-crossed branch when they differ.
-const MAIN_WEIGHT: f64 = 0.45;
-/// Weight shared by the other unstable branches.
-const OTHER_WEIGHT: f64 = 0.1;
 
 impl CutPrediction {
     /// The branches a chattering cut may show.
@@ -195,13 +187,20 @@ pub(crate) fn predict_cut(
     let s = inference_solver(&model);
     let (mu, chatter_hz, branches) = if with_frequency && !milling(&model) {
         // one Newton pass for the dominant root (FrequencyDomain's multiplier) and the others
-        let (dominant, others) = dominant_and_unstable_poles(&model, speed_rpm, depth_m).ok()?;
-        let mut roots = vec![dominant];
-        roots.extend(others);
+        let found = chatter_branches(&model, speed_rpm, depth_m).ok()?;
+        let dominant = found.first()?.at_width;
+        let mut branches = [None; BRANCHES];
+        for (slot, b) in branches.iter_mut().zip(&found) {
+            *slot = Some(ChatterBranch {
+                at_depth_hz: b.at_width_hz(),
+                crossing_hz: b.crossing_hz(),
+                weight: b.weight,
+            });
+        }
         (
             DominantMultiplier::new((dominant.lambda * tau).exp(), tau),
-            hz(&dominant),
-            turning_branches(&model, speed_rpm, depth_m, &roots),
+            found[0].at_width_hz(),
+            branches,
         )
     } else {
         let mu = s.dominant_multiplier(&model, speed_rpm, depth_m).ok()?;
@@ -217,63 +216,6 @@ pub(crate) fn predict_cut(
         chatter_hz,
         branches,
     })
-}
-
-/// Im lambda / 2 pi (Hz).
-fn hz(p: &ClosedLoopPole) -> f64 {
-    p.lambda.im / (2.0 * PI)
-}
-
-/// The branches of a turning cut (module docs): `roots` are the dominant root then the other
-/// unstable ones by decreasing growth rate. The dominant branch and the branch that crosses the
-/// axis at the smallest depth (the boundary's) weigh [`MAIN_WEIGHT`] each (both when they are
-/// one), the next two unstable branches share [`OTHER_WEIGHT`]; without other branches the
-/// weights are renormalized.
-fn turning_branches(
-    model: &ModalModel,
-    speed_rpm: f64,
-    depth_m: f64,
-    roots: &[ClosedLoopPole],
-) -> [Option<ChatterBranch>; BRANCHES] {
-    let crossings = axis_crossings(model, speed_rpm, depth_m, roots).unwrap_or_default();
-    let branch = |i: usize, weight: f64| {
-        let at_depth_hz = hz(&roots[i]);
-        let crossing_hz = crossings
-            .get(i)
-            .copied()
-            .flatten()
-            .map_or(at_depth_hz, |(_, p)| hz(&p));
-        ChatterBranch {
-            at_depth_hz,
-            crossing_hz,
-            weight,
-        }
-    };
-    let first_crossed = crossings
-        .iter()
-        .enumerate()
-        .filter_map(|(i, c)| c.map(|(width, _)| (i, width)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map_or(0, |(i, _)| i);
-    let mut chosen = vec![(0, MAIN_WEIGHT)];
-    if first_crossed != 0 {
-        chosen.push((first_crossed, MAIN_WEIGHT));
-    } else {
-        chosen[0].1 += MAIN_WEIGHT;
-    }
-    let others: Vec<usize> = (1..roots.len())
-        .filter(|&i| i != first_crossed)
-        .take(BRANCHES - chosen.len())
-        .collect();
-    for &i in &others {
-        chosen.push((i, OTHER_WEIGHT / others.len() as f64));
-    }
-    let total: f64 = chosen.iter().map(|c| c.1).sum();
-    let mut branches = [None; BRANCHES];
-    for (slot, (i, w)) in branches.iter_mut().zip(chosen) {
-        *slot = Some(branch(i, w / total));
-    }
-    branches
 }
 
 /// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).

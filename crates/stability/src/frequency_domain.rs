@@ -189,6 +189,90 @@ pub fn axis_crossings(
         .collect())
 }
 
+/// A root branch a chattering cut may vibrate on ([`chatter_branches`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChatterBranch {
+    /// The branch's root at the cut's width.
+    pub at_width: ClosedLoopPole,
+    /// Where the branch crosses the imaginary axis as the width is lowered: the width (m) and
+    /// the pole there (`None` when not found).
+    pub crossing: Option<(f64, ClosedLoopPole)>,
+    /// How often a chattering cut settles on it (sums to 1 over the branches).
+    pub weight: f64,
+}
+
+impl ChatterBranch {
+    /// Im lambda / 2 pi at the cut's width (Hz).
+    pub fn at_width_hz(&self) -> f64 {
+        self.at_width.lambda.im / (2.0 * PI)
+    }
+
+    /// Im lambda / 2 pi at the axis crossing (Hz), or at the cut's width when not found.
+    pub fn crossing_hz(&self) -> f64 {
+        self.crossing
+            .map_or(self.at_width.lambda, |(_, p)| p.lambda)
+            .im
+            / (2.0 * PI)
+    }
+}
+
+/// Branches a chattering cut is mixed over ([`chatter_branches`]).
+pub const CHATTER_BRANCHES: usize = 4;
+/// Weight of the dominant branch and of the first-crossed branch when they differ.
+const MAIN_WEIGHT: f64 = 0.45;
+/// Weight shared by the other unstable branches.
+const OTHER_WEIGHT: f64 = 0.1;
+
+/// Where a chattering turning cut at `speed_rpm` and width `width_m` vibrates, as a mixture
+/// over root branches, each between its axis crossing ([`axis_crossings`]: the limit cycle with
+/// loss of contact) and its root at the cut's width (the linear growth), with the dominant root
+/// first. Past the boundary several branches are unstable; time-domain simulations with loss of
+/// contact (`chatter_dynamics::simulate`, detected by `chatter_oma::detection`; the gap crate's
+/// example `chatter_frequency` and test `chatter_frequency`: a two-mode lathe at 1.5x and 2.5x
+/// the limit, 10 speeds) settle on the dominant branch or on the branch that crossed first
+/// (the boundary's) about equally often, now and then on another, 60-70 % of the way from the
+/// crossing to the root at the width. Weights: 0.45 each (0.9 when they are one branch), 0.1
+/// shared by the next two unstable branches, renormalized when there are fewer. A stable cut
+/// has the dominant root alone.
+pub fn chatter_branches(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+) -> Result<Vec<ChatterBranch>> {
+    let (dominant, others) = dominant_and_unstable_poles(model, speed_rpm, width_m)?;
+    let mut roots = vec![dominant];
+    roots.extend(others);
+    let crossings = axis_crossings(model, speed_rpm, width_m, &roots)?;
+    let first_crossed = crossings
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| c.map(|(width, _)| (i, width)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |(i, _)| i);
+    let mut chosen = vec![(0, MAIN_WEIGHT)];
+    if first_crossed == 0 {
+        chosen[0].1 += MAIN_WEIGHT;
+    } else {
+        chosen.push((first_crossed, MAIN_WEIGHT));
+    }
+    let others: Vec<usize> = (1..roots.len())
+        .filter(|&i| i != first_crossed)
+        .take(CHATTER_BRANCHES - chosen.len())
+        .collect();
+    for &i in &others {
+        chosen.push((i, OTHER_WEIGHT / others.len() as f64));
+    }
+    let total: f64 = chosen.iter().map(|c| c.1).sum();
+    Ok(chosen
+        .into_iter()
+        .map(|(i, w)| ChatterBranch {
+            at_width: roots[i],
+            crossing: crossings[i],
+            weight: w / total,
+        })
+        .collect())
+}
+
 /// The error when no Newton start converges.
 fn no_root(speed_rpm: f64, width_m: f64) -> StabilityError {
     StabilityError::NoConvergence {
@@ -314,6 +398,56 @@ mod tests {
             seen_others |= !others.is_empty();
         }
         assert!(seen_others, "no second unstable root up to 6x the limit");
+    }
+
+    /// The branches of a chattering cut: at 1.5x, 3x and 6x the limit (seed-000 lathe, and with
+    /// process damping C = 2e4 N/m at 2000 rpm) the first-crossed branch crosses the axis at
+    /// the limiting depth of the boundary search (within its tolerance, 1e-6 relative here
+    /// with the tighter search below) and at its chatter frequency (the dominant root there,
+    /// within 1e-4 Hz), the crossing is a root of the characteristic equation with Re = 0, the
+    /// dominant branch comes first, and the weights sum to 1.
+    #[test]
+    fn the_first_crossed_branch_crosses_at_the_boundary() {
+        use crate::boundary::{BoundaryOptions, limiting_depth};
+        let bare = examples::ahmadi_2022_turning();
+        let options = BoundaryOptions {
+            tolerance: 1e-9,
+            ..BoundaryOptions::default()
+        };
+        for (model, speed) in [
+            (bare.clone(), 7150.0),
+            (bare.with_process_damping(Some(2e4)).unwrap(), 2000.0),
+        ] {
+            let limit = limiting_depth(&FrequencyDomain, &model, speed, &options)
+                .unwrap()
+                .depth_m;
+            let boundary = dominant_pole(&model, speed, limit).unwrap();
+            let ch = Characteristic::new(&model, speed).unwrap();
+            for factor in [1.5, 3.0, 6.0] {
+                let branches = chatter_branches(&model, speed, factor * limit).unwrap();
+                let dominant = dominant_pole(&model, speed, factor * limit).unwrap();
+                assert_eq!(branches[0].at_width, dominant);
+                let total: f64 = branches.iter().map(|b| b.weight).sum();
+                assert!((total - 1.0).abs() < 1e-12);
+                let (width, pole) = branches
+                    .iter()
+                    .filter_map(|b| b.crossing)
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .unwrap();
+                assert!((width / limit - 1.0).abs() < 1e-6, "{width} vs {limit}");
+                assert!(
+                    (pole.lambda.im - boundary.lambda.im).abs() / (2.0 * PI) < 1e-4,
+                    "{} vs {}",
+                    pole.frequency_hz,
+                    boundary.frequency_hz
+                );
+                for (w, p) in branches.iter().filter_map(|b| b.crossing) {
+                    assert!(p.lambda.re.abs() <= 1e-9 * p.lambda.norm());
+                    let step = ch.newton_step(p.lambda, w).unwrap();
+                    assert!(step.norm() <= 1e-8 * p.lambda.norm(), "{step}");
+                }
+            }
+        }
     }
 
     /// Turning with process damping (seed-000 lathe, C = 2e4 N/m, 38 mm workpiece): the poles
