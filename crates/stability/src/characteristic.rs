@@ -202,8 +202,9 @@ impl Characteristic {
     /// as the width is lowered: `(a_c, lambda_c)` with Re lambda_c = 0 (to 1e-9 |lambda_c|),
     /// `None` when the root is not unstable or the branch is lost (no crossing above zero width,
     /// Newton leaves the branch). The root is followed by Newton's method from width to width
-    /// (each step at most a fifth of the width, the iterate kept within 5 % of its start) and
-    /// a_c found by the secant rule on Re lambda(a).
+    /// (each step at most a fifth of the width, halved up to six times where Newton does not
+    /// converge, the iterate kept within 5 % of its start) and a_c found by the secant rule on
+    /// Re lambda(a).
     ///
     /// This is the describing-function frequency of a limit cycle with loss of contact: the
     /// tool leaving the cut scales the cutting force's first harmonic by a real gain below one,
@@ -214,6 +215,7 @@ impl Characteristic {
         const ITERATIONS: usize = 60;
         const MAX_STEP: f64 = 0.2;
         const BRANCH: f64 = 0.05;
+        const HALVINGS: usize = 6;
         if lambda.re <= 0.0 || a <= 0.0 {
             return None;
         }
@@ -232,20 +234,29 @@ impl Characteristic {
                 .map(|(a0, l0)| a1 - l1.re * (a1 - a0) / (l1.re - l0.re));
             let mut target = secant.unwrap_or(a1 * (1.0 - MAX_STEP));
             target = target.clamp(a1 * (1.0 - MAX_STEP), a1 * (1.0 + MAX_STEP));
-            if let Some((a_low, _)) = low {
-                if !(target > a_low && target < high.0) {
+            // the crossing lies below the narrowest unstable width (and above the widest stable
+            // one): a secant pointing elsewhere (Re lambda need not fall with the width) is
+            // replaced by a step down or a bisection
+            match low {
+                Some((a_low, _)) if !(target > a_low && target < high.0) => {
                     target = 0.5 * (a_low + high.0);
                 }
+                None if target >= high.0 => target = high.0 * (1.0 - MAX_STEP),
+                _ => {}
             }
             if !(target > 0.0) {
                 return None;
             }
-            // follow the branch from the bracket end nearer in width
-            let start = match low {
-                Some(lo) if (lo.0 - target).abs() < (high.0 - target).abs() => lo.1,
-                _ => high.1,
+            // follow the branch from the bracket end nearer in width; where Newton fails (two
+            // roots of the chain close together) halve the step towards that end and retry
+            let (from_a, start) = match low {
+                Some(lo) if (lo.0 - target).abs() < (high.0 - target).abs() => lo,
+                _ => high,
             };
-            let l = self.newton_within(start, target, 30, BRANCH)?;
+            let (target, l) = (0..HALVINGS).find_map(|k| {
+                let t = from_a + (target - from_a) * 0.5f64.powi(k as i32);
+                self.newton_within(start, t, 30, BRANCH).map(|l| (t, l))
+            })?;
             if l.re > 0.0 {
                 high = (target, l);
             } else {

@@ -411,7 +411,7 @@ mod tests {
         use crate::boundary::{BoundaryOptions, limiting_depth};
         let bare = examples::ahmadi_2022_turning();
         let options = BoundaryOptions {
-            tolerance: 1e-9,
+            relative_tolerance: 1e-9,
             ..BoundaryOptions::default()
         };
         for (model, speed) in [
