@@ -10,7 +10,7 @@
 //! (the first prescription and the likelihood before the branches) explains at least
 //! three fewer: past the boundary the limit cycle often settles on the boundary's branch, tens
 //! of Hz from the dominant root. Measured (seed-fixed): 19 detected, 19 within a branch (13 on
-//! the dominant one, 4 on the first-crossed, 2 on others), 13 by the dominant root alone.
+//! the dominant one, 5 on the first-crossed, 1 on another), 13 by the dominant root alone.
 #![allow(clippy::unwrap_used)]
 
 #[allow(dead_code)]
