@@ -12,8 +12,9 @@
 //!   folded over the tooth-passing harmonics and taken against the nearer of the images
 //!   k f_tp +- f_mu (a wrapped normal).
 //! - A pole's frequency and damping ratio are Gaussian around the predicted pole with the
-//!   observation's standard deviations (or the defaults); a milling pole's principal frequency is
-//!   folded into [0, f_tp / 2] like the data.
+//!   observation's standard deviations (or the defaults), mixed with equal weights over the
+//!   candidates a turning identification may report (each mode's pole and the resonance); a
+//!   milling pole's principal frequency is folded into [0, f_tp / 2] like the data.
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
@@ -318,21 +319,25 @@ pub(crate) fn terms(prediction: &Prediction, data: &Dataset, noise: &NoiseModel)
         .map(|(i, p)| {
             // frequency uniform over [0, 2 f], damping over a unit interval
             let uniform = -(2.0 * p.frequency_hz.max(1.0)).ln();
-            match prediction.poles[i] {
-                Some(q) => {
+            let candidates = &prediction.pole_candidates[i];
+            if candidates.is_empty() {
+                return uniform;
+            }
+            let ln_weight = -(candidates.len() as f64).ln();
+            let ln: Vec<f64> = candidates
+                .iter()
+                .flat_map(|q| {
                     let z = ln_normal(p.damping_ratio - q.damping_ratio, p.damping_std);
-                    let ln: Vec<f64> = pole_frequency_images(
+                    pole_frequency_images(
                         p.frequency_hz,
                         q.frequency_hz,
                         prediction.pole_fold_hz[i],
                     )
                     .into_iter()
-                    .map(|r| z + ln_normal(r, p.frequency_std_hz))
-                    .collect();
-                    with_lapse(log_sum_exp(&ln), uniform, noise.lapse)
-                }
-                None => uniform,
-            }
+                    .map(move |r| ln_weight + z + ln_normal(r, p.frequency_std_hz))
+                })
+                .collect();
+            with_lapse(log_sum_exp(&ln), uniform, noise.lapse)
         })
         .collect();
     Terms {

@@ -37,9 +37,9 @@
 //!   resonance (the dominant root off the spindle harmonics and above 0.85 times the lowest
 //!   natural frequency, `chatter_stability::resonance`: under process damping at low speed the
 //!   dominant roots are those of slow surface regeneration, which respond at spindle harmonics
-//!   and are removed by an identification) or a mode's own continued pole, whichever lies
-//!   closest in frequency to the identified one (mode pairing: an identification of a two-mode
-//!   lathe may report either mode's pole).
+//!   and are removed by an identification) or a mode's own continued pole, mixed with equal
+//!   weights (an identification of a two-mode lathe may report either mode's pole; the
+//!   residuals and the checks take the candidate nearest the identified frequency).
 //!
 //! # Accuracy
 //! Against the semi-discretization at four times the resolution (the proving ground's truth)
@@ -133,8 +133,12 @@ pub(crate) struct Prediction {
     pub cuts: Vec<Option<CutPrediction>>,
     /// Fold of each cut's chatter frequency: tooth passing (milling), None for turning.
     pub cut_fold_hz: Vec<Option<f64>>,
-    /// Each pole (None: the solver failed).
+    /// Each pole (None: the solver failed): the candidate nearest the identified frequency.
     pub poles: Vec<Option<PredictedPole>>,
+    /// Each pole's candidates, which the likelihood mixes with equal weights: for turning
+    /// every mode's continued pole and the resonance, for milling the dominant multiplier's pole
+    /// alone (empty where the solver failed).
+    pub pole_candidates: Vec<Vec<PredictedPole>>,
     /// Fold of each pole's principal frequency (milling only).
     pub pole_fold_hz: Vec<Option<f64>>,
     /// Solver failures among the evaluations.
@@ -218,13 +222,16 @@ pub(crate) fn predict_cut(
     })
 }
 
-/// The pole an identification of a stable cut reports: lifted (milling) or physical (turning).
-/// For milling it is the dominant multiplier's. For turning, where an identification of a
-/// multi-mode machine may lock onto a mode's own pole rather than the least-damped root, it is
-/// the one of {the resonance (dominant root off the spindle harmonics), each mode's continued
-/// pole} closest in frequency to the identified `observed_hz` (mode pairing, as in modal
-/// updating); the roots of slow surface regeneration, dominant under process damping at low
-/// speed, respond at spindle harmonics, which an identification removes.
+/// The poles an identification of a stable cut may report: lifted (milling) or physical
+/// (turning), and of them the one nearest in frequency to the identified `observed_hz`. For
+/// milling it is the dominant multiplier's alone. For turning, where an identification of a
+/// multi-mode machine may lock onto a mode's own pole rather than the least-damped root, they are
+/// the resonance (dominant root off the spindle harmonics) and each mode's continued pole; the
+/// likelihood mixes them with equal weights (a pairing by the nearest alone, a maximum over the
+/// candidates, would reward a model for every extra pole it offers: on the proving ground's lathe
+/// an extra mode gained 1-3 nats of evidence on campaigns without one); the roots of slow
+/// surface regeneration, dominant under process damping at low speed, respond at spindle
+/// harmonics, which an identification removes.
 pub(crate) fn predict_pole(
     variant: &Variant,
     speed_rpm: f64,
@@ -232,9 +239,9 @@ pub(crate) fn predict_pole(
     immersion: Option<f64>,
     u: f64,
     observed_hz: f64,
-) -> Option<PredictedPole> {
+) -> Option<(PredictedPole, Vec<PredictedPole>)> {
     let model = variant.at(immersion, speed_rpm, u).ok()?;
-    let pole = if milling(&model) {
+    let candidates = if milling(&model) {
         let mu = inference_solver(&model)
             .dominant_multiplier(&model, speed_rpm, depth_m)
             .ok()?;
@@ -242,7 +249,7 @@ pub(crate) fn predict_pole(
             mu.modulus().ln() / mu.period_s,
             2.0 * PI * mu.principal_frequency_hz(),
         );
-        observed_pole(lambda, true)
+        vec![observed_pole(lambda, true)]
     } else {
         let dominant = dominant_resonance_pole(&model, speed_rpm, depth_m).ok()?;
         mode_poles(&model, speed_rpm, depth_m)
@@ -251,13 +258,15 @@ pub(crate) fn predict_pole(
             .flatten()
             .chain(std::iter::once(dominant))
             .map(|p| observed_pole(p.lambda, false))
-            .min_by(|a, b| {
-                (a.frequency_hz - observed_hz)
-                    .abs()
-                    .total_cmp(&(b.frequency_hz - observed_hz).abs())
-            })?
+            .filter(|p| p.frequency_hz.is_finite() && p.damping_ratio.is_finite())
+            .collect()
     };
-    (pole.frequency_hz.is_finite() && pole.damping_ratio.is_finite()).then_some(pole)
+    let nearest = candidates.iter().copied().min_by(|a, b| {
+        (a.frequency_hz - observed_hz)
+            .abs()
+            .total_cmp(&(b.frequency_hz - observed_hz).abs())
+    })?;
+    Some((nearest, candidates))
 }
 
 /// A continuous-time pole as it is identified: frequency |Im lambda| / 2 pi for a lifted
@@ -292,7 +301,7 @@ pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
             )
         })
         .collect();
-    let poles: Vec<Option<PredictedPole>> = data
+    let (poles, pole_candidates): (Vec<Option<PredictedPole>>, Vec<Vec<PredictedPole>>) = data
         .poles
         .iter()
         .map(|p| {
@@ -304,8 +313,9 @@ pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
                 p.u,
                 p.frequency_hz,
             )
+            .map_or((None, Vec::new()), |(nearest, all)| (Some(nearest), all))
         })
-        .collect();
+        .unzip();
     let failures =
         cuts.iter().filter(|c| c.is_none()).count() + poles.iter().filter(|p| p.is_none()).count();
     Prediction {
@@ -313,6 +323,7 @@ pub(crate) fn predict(variant: &Variant, data: &Dataset) -> Prediction {
         pole_fold_hz: data.poles.iter().map(|p| fold(p.speed_rpm)).collect(),
         cuts,
         poles,
+        pole_candidates,
         failures,
     }
 }
