@@ -238,13 +238,13 @@ impl Characteristic {
             // one): a secant pointing elsewhere (Re lambda need not fall with the width) is
             // replaced by a step down or a bisection
             match low {
-                Some((a_low, _)) if !(target > a_low && target < high.0) => {
+                Some((a_low, _)) if target.is_nan() || target <= a_low || target >= high.0 => {
                     target = 0.5 * (a_low + high.0);
                 }
                 None if target >= high.0 => target = high.0 * (1.0 - MAX_STEP),
                 _ => {}
             }
-            if !(target > 0.0) {
+            if target.is_nan() || target <= 0.0 {
                 return None;
             }
             // follow the branch from the bracket end nearer in width; where Newton fails (two
