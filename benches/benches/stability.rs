@@ -13,7 +13,7 @@ use chatter_progress::Silent;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, lobe_diagram, speed_range};
 use chatter_stability::frequency_domain::dominant_and_unstable_poles;
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::prepared::{Method, PreparedDiscretization, PreparedSolver};
 use chatter_stability::zero_order::{zoa_limiting_depth, zoa_lobes};
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -21,8 +21,8 @@ use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
     let benchmark = examples::insperger_benchmark(1.0);
-    let fdm40 = Discretization::full().with_steps(40);
-    let sdm40 = Discretization::semi().with_steps(40);
+    let fdm40 = Discretization::full().with_steps(steps::<40>());
+    let sdm40 = Discretization::semi().with_steps(steps::<40>());
     c.bench_function("multiplier_sdof_fdm_m40", |b| {
         b.iter(|| fdm40.dominant_multiplier(&benchmark, 10_000.0, 0.3e-3))
     });

@@ -5,7 +5,7 @@
 //! montecarlo`).
 use chatter_dynamics::{Parameter, examples};
 use chatter_stability::boundary::{BoundaryOptions, speed_range};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::prepared::{Method, SolverOptions};
 use chatter_uncertainty::montecarlo::{gaussian_draws, sample_boundaries};
 use chatter_uncertainty::perturbation::model_moment_grid;
@@ -15,7 +15,7 @@ use nalgebra::DMatrix;
 
 fn bench(c: &mut Criterion) {
     let model = examples::insperger_benchmark(0.05);
-    let fdm40 = Discretization::full().with_steps(40);
+    let fdm40 = Discretization::full().with_steps(steps::<40>());
     let params: Vec<Parameter> = ["theta_omega_1", "theta_zeta_1", "theta_k_1"]
         .iter()
         .filter_map(|s| s.parse().ok())

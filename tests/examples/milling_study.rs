@@ -22,7 +22,7 @@ use chatter_oma::signals::Signals;
 use chatter_oma::{IdentifyOptions, identify};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use chatter_stability::monodromy::{Discretization, steps, steps_at_least};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
@@ -64,15 +64,8 @@ fn machine() -> ModalModel {
 
 /// The truth's solver: the full discretization at 4x its automatic resolution (at least 200).
 fn truth(model: &ModalModel, speed_rpm: f64) -> Discretization {
-    let m = match Discretization::full()
-        .resolved(model, speed_rpm)
-        .unwrap()
-        .steps
-    {
-        StepsPerDelay::Fixed(m) => m,
-        StepsPerDelay::Auto => 50,
-    };
-    Discretization::full().with_steps((4 * m).max(200))
+    let m = Discretization::full().steps_at(model, speed_rpm);
+    Discretization::full().with_steps(steps_at_least(4 * m.get(), steps::<200>()))
 }
 
 fn record(model: &ModalModel, speed_rpm: f64, depth_m: f64, seconds: f64, seed: u64) -> Signals {

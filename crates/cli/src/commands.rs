@@ -182,7 +182,7 @@ pub fn warn_unbounded(lobes: &[LobePoint], fate: &str) {
 /// Options of `chatter lobes` beyond the lobe CSV and plot ([`crate::lobe_map`]).
 pub struct LobeExtras<'a> {
     /// Fixed fdm/sdm cutting steps per delay.
-    pub cutting_steps: Option<usize>,
+    pub cutting_steps: Option<std::num::NonZeroUsize>,
     /// |mu| map CSV.
     pub map_out: Option<&'a Path>,
     /// |mu| heat map SVG.
@@ -353,10 +353,7 @@ pub fn multiplier(
         bail!("--method zoa gives limiting depths, not multipliers; use fdm or sdm");
     };
     validate::work_size(&model, solver, &[speed_rpm], "--speed-rpm")?;
-    let steps = match solver.resolved(&model, speed_rpm)?.steps {
-        chatter_stability::monodromy::StepsPerDelay::Fixed(m) => m.to_string(),
-        chatter_stability::monodromy::StepsPerDelay::Auto => "auto".into(),
-    };
+    let steps = solver.steps_at(&model, speed_rpm);
     let working = Working::start(
         &format!(
             "multiplier: {} at {speed_rpm} rpm, {steps} steps per delay",

@@ -19,7 +19,7 @@ pub const DEFAULT_MAP_DEPTHS: usize = 80;
 pub fn solver(
     model: &ModalModel,
     method: Method,
-    cutting_steps: Option<usize>,
+    cutting_steps: Option<std::num::NonZeroUsize>,
 ) -> Result<Box<dyn PreparedSolver>> {
     let options = BoundaryOptions::default();
     Ok(match (method.discretization(), cutting_steps) {

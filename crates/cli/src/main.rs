@@ -370,7 +370,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out.as_deref(),
             plot.as_deref(),
             &commands::LobeExtras {
-                cutting_steps: cutting_steps.map(std::num::NonZeroUsize::get),
+                cutting_steps,
                 map_out: map_out.as_deref(),
                 map_plot: map_plot.as_deref(),
                 depths: depths.as_deref(),

@@ -6,7 +6,9 @@ use anyhow::Result;
 use chatter_dynamics::examples;
 use chatter_progress::Silent;
 use chatter_uncertainty::geometric::{OffsetBoundaries, schmitz2023};
-use chatter_uncertainty::sensitivity::{TransitionMap, pole_sensitivity};
+use chatter_uncertainty::sensitivity::{
+    TABLE3_STEPS_PER_REVOLUTION, TransitionMap, pole_sensitivity,
+};
 use chatter_updating::{ebrahimi2025, karandikar, schmitz2022};
 use std::fmt::Write as _;
 
@@ -52,7 +54,14 @@ fn ahmadi_table_3() -> Result<Vec<Row>> {
     ];
     let mut rows = Vec::new();
     for (point, rpm, mm, paper) in table {
-        let s = pole_sensitivity(&model, &params, rpm, mm * 1e-3, 200, TransitionMap::OneStep)?;
+        let s = pole_sensitivity(
+            &model,
+            &params,
+            rpm,
+            mm * 1e-3,
+            TABLE3_STEPS_PER_REVOLUTION,
+            TransitionMap::OneStep,
+        )?;
         for ((entry, name), p) in s.entries.iter().zip(names).zip(paper) {
             rows.push(Row {
                 source: "000 Table 3".into(),

@@ -35,7 +35,7 @@ pub struct SensitivityArgs {
     #[arg(long)]
     parameters: Option<String>,
     /// Full-discretization steps per revolution (per tooth period in milling).
-    #[arg(long, default_value_t = TABLE3_STEPS_PER_REVOLUTION)]
+    #[arg(long, default_value_t = TABLE3_STEPS_PER_REVOLUTION.get())]
     steps_per_revolution: usize,
     /// The differentiated map.
     #[arg(long, value_enum, default_value = "one-step")]
@@ -85,12 +85,14 @@ pub fn run(args: &SensitivityArgs) -> Result<()> {
     if !(args.depth_mm.is_finite() && args.depth_mm > 0.0) {
         bail!("--depth-mm {}: expected a depth > 0", args.depth_mm);
     }
-    if args.steps_per_revolution < 2 {
+    let Some(steps_per_revolution) =
+        std::num::NonZeroUsize::new(args.steps_per_revolution).filter(|m| m.get() >= 2)
+    else {
         bail!(
             "--steps-per-revolution {}: expected at least 2",
             args.steps_per_revolution
         );
-    }
+    };
     let params = parameters(args.parameters.as_deref(), model.mode_count())?;
     let map = match args.map {
         MapArg::OneStep => TransitionMap::OneStep,
@@ -101,7 +103,7 @@ pub fn run(args: &SensitivityArgs) -> Result<()> {
         &params,
         args.speed_rpm,
         args.depth_mm * 1e-3,
-        args.steps_per_revolution,
+        steps_per_revolution,
         map,
     )?;
     let entries: Vec<_> = s

@@ -9,7 +9,7 @@
 use anyhow::{Result, bail};
 use chatter_dynamics::limits::{Plausible, SPEED_RPM, closed, open_closed, written};
 use chatter_dynamics::{ModalModel, Observations, Operation};
-use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use chatter_stability::monodromy::Discretization;
 
 /// Most cutting steps per delay a discretization may use. The cost of one multiplier grows as
 /// the square of the steps (measured on the seed-000 turning model, debug build: 1 400 steps
@@ -177,10 +177,7 @@ pub fn work_size(
     let Some(&slowest) = speeds.iter().min_by(|a, b| a.total_cmp(b)) else {
         return Ok(());
     };
-    let resolved = method.resolved(model, slowest)?;
-    let StepsPerDelay::Fixed(steps) = resolved.steps else {
-        return Ok(());
-    };
+    let steps = method.steps_at(model, slowest).get();
     if steps > MAX_STEPS_PER_DELAY {
         // steps per delay scale as 1 / speed
         let lowest = slowest * steps as f64 / MAX_STEPS_PER_DELAY as f64;

@@ -191,6 +191,42 @@ pub fn process_damping_flexure(c_n_per_m: Option<f64>) -> ModalModel {
     build().unwrap_or_else(|e| panic!("003-like flexure with C = {c_n_per_m:?}: {e}"))
 }
 
+/// The 2-DOF mill of issue 14, on which lobes and Monte Carlo maps used to abort in the
+/// eigen-solver (a Hessenberg QR that did not converge at 23 500 rpm): 3 teeth of a 12.7 mm
+/// cutter in 75 % down milling, kt 700 and kn 210 N/mm^2, x and y modes at 918.8 and 889.3 Hz
+/// (damping ratio 0.03, 7.82e6 and 7.52e6 N/m): a nearly symmetric tool.
+pub fn issue_14_mill() -> ModalModel {
+    let build = || -> crate::Result<ModalModel> {
+        let mode = |frequency_hz, stiffness_n_per_m, coordinate| {
+            Mode::new(
+                frequency_hz,
+                0.03,
+                ModeShape::Directional {
+                    coordinate,
+                    stiffness_n_per_m,
+                },
+            )
+        };
+        ModalModel::new(
+            Some("issue 14 mill".into()),
+            Operation::Milling(Milling::new(
+                3,
+                0.75,
+                MillingDirection::Down,
+                Some(12.7e-3),
+                None,
+            )?),
+            CuttingCoefficients::new(700e6, 210e6)?,
+            vec![
+                mode(918.817_583_621_353_3, 7_815_703.869_117_313, 0)?,
+                mode(889.340_042_863_237, 7_516_307.737_741_677, 1)?,
+            ],
+            None,
+        )
+    };
+    build().unwrap_or_else(|e| panic!("issue 14 mill: {e}"))
+}
+
 /// The gap proving ground's lathe: a 640 Hz feed mode (damping ratio 0.03, 2.5e7 N/m) and a
 /// 700 Hz mode at 30 degrees (0.035, 3e7 N/m), a 50 mm workpiece, kt 1500 and kn 600 N/mm^2,
 /// and the process-damping coefficient `c_n_per_m` (N/m). With C about 1e6 N/m and more, slow

@@ -44,7 +44,7 @@ use chatter_dynamics::{
 };
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use chatter_stability::monodromy::{Discretization, steps, steps_at_least};
 use num_complex::Complex64;
 use rand::rngs::StdRng;
 use rand::seq::SliceRandom;
@@ -52,10 +52,11 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
 use std::f64::consts::PI;
+use std::num::NonZeroUsize;
 
 /// Resolution of the truth relative to the automatic one, and its floor.
 const TRUTH_REFINEMENT: usize = 4;
-const TRUTH_MIN_STEPS: usize = 160;
+const TRUTH_MIN_STEPS: NonZeroUsize = steps::<160>();
 
 /// The effect hidden in the true machine.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -379,23 +380,16 @@ pub fn proving_machines() -> Result<Vec<ProvingMachine>> {
 }
 
 /// The truth's solver for `model` at `speed_rpm` (see the module docs).
-pub fn truth_solver(model: &ModalModel, speed_rpm: f64) -> Result<Discretization> {
+pub fn truth_solver(model: &ModalModel, speed_rpm: f64) -> Discretization {
     truth_solver_refined(model, speed_rpm, TRUTH_REFINEMENT)
 }
 
-fn truth_solver_refined(
-    model: &ModalModel,
-    speed_rpm: f64,
-    refinement: usize,
-) -> Result<Discretization> {
-    let auto = Discretization::semi()
-        .resolved(model, speed_rpm)
-        .map_err(|e| GapError::Model(e.to_string()))?;
-    let m = match auto.steps {
-        StepsPerDelay::Fixed(m) => m,
-        StepsPerDelay::Auto => TRUTH_MIN_STEPS,
-    };
-    Ok(Discretization::semi().with_steps((refinement * m).max(TRUTH_MIN_STEPS)))
+fn truth_solver_refined(model: &ModalModel, speed_rpm: f64, refinement: usize) -> Discretization {
+    let auto = Discretization::semi().steps_at(model, speed_rpm);
+    Discretization::semi().with_steps(steps_at_least(
+        refinement.saturating_mul(auto.get()),
+        TRUTH_MIN_STEPS,
+    ))
 }
 
 /// `f` with the truth's solver; when its eigen-solver fails (Arnoldi can stall on clustered
@@ -407,7 +401,7 @@ fn with_truth<T>(
     speed_rpm: f64,
     f: impl Fn(&Discretization) -> chatter_stability::Result<T>,
 ) -> Result<T> {
-    let semi = truth_solver(model, speed_rpm)?;
+    let semi = truth_solver(model, speed_rpm);
     let first = match f(&semi) {
         Ok(v) => return Ok(v),
         Err(e) => e,
@@ -416,13 +410,10 @@ fn with_truth<T>(
         model,
         speed_rpm,
         TRUTH_REFINEMENT + 1,
-    )?) {
+    )) {
         return Ok(v);
     }
-    let full = Discretization::full().with_steps(match semi.steps {
-        StepsPerDelay::Fixed(m) => m,
-        StepsPerDelay::Auto => TRUTH_MIN_STEPS,
-    });
+    let full = Discretization::full().with_steps(semi.steps_at(model, speed_rpm));
     f(&full).map_err(|e| GapError::Model(format!("{first}; on finer and other grids: {e}")))
 }
 

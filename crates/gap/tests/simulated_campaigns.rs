@@ -39,7 +39,6 @@ fn simulated_turning_control() {
     for p in &data.poles {
         let depth_m = p.depth_mm * 1e-3;
         let (mu, f) = truth_solver(model, p.speed_rpm)
-            .unwrap()
             .resonance_frequency_hz(model, p.speed_rpm, depth_m)
             .unwrap();
         let re = mu.modulus().ln() / mu.period_s;

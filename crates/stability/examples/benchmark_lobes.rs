@@ -1,14 +1,14 @@
 //! Print limiting depths of the single-DOF milling benchmark with FDM and SDM at several m.
 use chatter_dynamics::examples;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     for ad in [1.0, 0.05] {
         let model = examples::insperger_benchmark(ad);
         for rpm in [5000.0, 10000.0, 15000.0, 20000.0, 25000.0] {
             let mut line = format!("a/D={ad} {rpm} rpm:");
-            for m in [20, 40, 80, 160] {
+            for m in [steps::<20>(), steps::<40>(), steps::<80>(), steps::<160>()] {
                 for d in [
                     Discretization::full().with_steps(m),
                     Discretization::semi().with_steps(m),

@@ -9,7 +9,7 @@
 
 use chatter_dynamics::{ModalModel, Operation, examples};
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use chatter_stability::monodromy::{AUTO_MIN_STEPS, Discretization, steps, steps_at_least};
 use chatter_stability::prepared::Method;
 use std::f64::consts::PI;
 
@@ -51,7 +51,8 @@ fn main() {
         for rpm in speeds {
             let (entry, exit) = op.entry_exit_rad();
             let cutting_s = (exit - entry) / (2.0 * PI) * 60.0 / rpm;
-            let m_ref = ((240.0 * f_max * cutting_s).ceil() as usize).max(1600);
+            let m_ref =
+                steps_at_least((240.0 * f_max * cutting_s).ceil() as usize, steps::<1600>());
             let reference_scheme = if model.process_damping_n_per_m().is_some() {
                 Discretization::full()
             } else {
@@ -59,18 +60,17 @@ fn main() {
             };
             let reference = depth(reference_scheme.with_steps(m_ref), &model, rpm, 1e-6);
             let mut line = String::new();
-            let mut m_auto = 0;
+            let mut m_auto = AUTO_MIN_STEPS;
             for (method, worst) in [(Method::Fdm, &mut worst_fdm), (Method::Sdm, &mut worst_sdm)] {
                 let scheme = method.discretization().unwrap_or_else(Discretization::full);
-                if let Ok(Discretization {
-                    steps: StepsPerDelay::Fixed(m),
-                    ..
-                }) = scheme.resolved(&model, rpm)
-                {
-                    m_auto = m;
-                }
+                m_auto = scheme.steps_at(&model, rpm);
                 let b1 = depth(scheme.with_steps(m_auto), &model, rpm, 1e-4);
-                let b2 = depth(scheme.with_steps(2 * m_auto), &model, rpm, 1e-4);
+                let b2 = depth(
+                    scheme.with_steps(m_auto.saturating_mul(steps::<2>())),
+                    &model,
+                    rpm,
+                    1e-4,
+                );
                 let prepared = method
                     .prepare(&model, &BoundaryOptions::default())
                     .and_then(|p| p.limiting_depth(rpm))

@@ -4,7 +4,7 @@
 use chatter_dynamics::examples;
 use chatter_progress::Silent;
 use chatter_stability::boundary::{BoundaryOptions, lobe_diagram};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::zero_order::zoa_lobes;
 
 /// The 003-like flexure: zero-order (process damping by the rotation-averaged projector) against
@@ -13,7 +13,7 @@ fn flexure() -> Result<(), Box<dyn std::error::Error>> {
     use chatter_stability::boundary::limiting_depth;
     use chatter_stability::zero_order::{ZeroOrderOptions, limiting_depths};
     let speeds = [300.0, 400.0, 600.0, 1000.0, 1500.0, 2000.0, 2500.0, 3000.0];
-    let fdm = Discretization::full().with_steps(1600);
+    let fdm = Discretization::full().with_steps(steps::<1600>());
     for c in [Some(2.5e5), None] {
         let model = examples::process_damping_flexure(c);
         let zoa = limiting_depths(&model, &speeds, &ZeroOrderOptions::unbounded())?;

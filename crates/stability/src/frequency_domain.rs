@@ -458,14 +458,14 @@ mod tests {
     #[test]
     fn process_damping_agrees_with_discretization() {
         use crate::boundary::{BoundaryOptions, limiting_depth};
-        use crate::monodromy::Discretization;
+        use crate::monodromy::{Discretization, steps};
         let bare = examples::ahmadi_2022_turning();
         let model = bare.with_process_damping(Some(2e4)).unwrap();
         let options = BoundaryOptions::default();
         for speed in [2000.0, 7150.0] {
             let poles = limiting_depth(&FrequencyDomain, &model, speed, &options).unwrap();
             let fdm = limiting_depth(
-                &Discretization::full().with_steps(4000),
+                &Discretization::full().with_steps(steps::<4000>()),
                 &model,
                 speed,
                 &options,

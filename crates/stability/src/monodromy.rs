@@ -39,7 +39,7 @@
 
 use crate::StabilitySolver;
 use crate::eigen::dense_eigenvalues;
-use crate::error::{Result, StabilityError, check_condition};
+use crate::error::{Result, check_condition};
 use crate::grid::segments;
 pub use crate::krylov::DENSE_FALLBACK_MAX_DIM;
 use crate::krylov::{DENSE_MAX_DIM, largest, robust_eigenpair};
@@ -49,6 +49,7 @@ use chatter_dynamics::ModalModel;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::f64::consts::PI;
+use std::num::NonZeroUsize;
 
 /// Which discretization scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,12 +76,31 @@ pub enum StepsPerDelay {
     /// Chosen from the physics: at least [`AUTO_MIN_STEPS`] and at least
     /// [`AUTO_STEPS_PER_CYCLE`] steps per period of the highest natural frequency while cutting.
     Auto,
-    /// A fixed number of cutting steps (m = 40 is the usual speed benchmark).
-    Fixed(usize),
+    /// A fixed number of cutting steps (m = 40 is the usual speed benchmark); never zero, so a
+    /// discretization without steps cannot be built.
+    Fixed(NonZeroUsize),
+}
+
+/// `N` cutting steps for [`Discretization::with_steps`], checked when the program is compiled:
+/// `steps::<0>()` does not build. Counts known only at run time come as [`NonZeroUsize`]
+/// (`NonZeroUsize::new(n)` is `None` for zero).
+pub const fn steps<const N: usize>() -> NonZeroUsize {
+    const {
+        match NonZeroUsize::new(N) {
+            Some(n) => n,
+            None => panic!("a discretization needs at least one cutting step"),
+        }
+    }
+}
+
+/// `n` cutting steps, or `floor` where `n` is smaller (zero included): a count computed from the
+/// physics with a least resolution.
+pub fn steps_at_least(n: usize, floor: NonZeroUsize) -> NonZeroUsize {
+    NonZeroUsize::new(n).map_or(floor, |n| n.max(floor))
 }
 
 /// Minimum number of cutting steps of the automatic resolution.
-pub const AUTO_MIN_STEPS: usize = 40;
+pub const AUTO_MIN_STEPS: NonZeroUsize = steps::<40>();
 /// Steps per vibration cycle of the highest mode in the automatic resolution; chosen so that the
 /// limiting depth is within 2 % of the converged one over the speed range (see the tests).
 pub const AUTO_STEPS_PER_CYCLE: f64 = 24.0;
@@ -109,8 +129,8 @@ impl Discretization {
             steps: StepsPerDelay::Auto,
         }
     }
-    /// The same scheme with a fixed number of cutting steps.
-    pub fn with_steps(self, m: usize) -> Self {
+    /// The same scheme with `m` cutting steps per delay (a literal count: [`steps`]).
+    pub fn with_steps(self, m: NonZeroUsize) -> Self {
         Self {
             steps: StepsPerDelay::Fixed(m),
             ..self
@@ -120,33 +140,36 @@ impl Discretization {
     /// The same solver with the step count that [`StepsPerDelay::Auto`] picks for `model` at
     /// `speed_rpm` made fixed, so that models perturbed around `model` (finite differences,
     /// samplers) share one grid and their operators have the same dimension.
-    pub fn resolved(self, model: &ModalModel, speed_rpm: f64) -> Result<Self> {
+    pub fn resolved(self, model: &ModalModel, speed_rpm: f64) -> Self {
+        self.with_steps(self.steps_at(model, speed_rpm))
+    }
+
+    /// The cutting steps per delay of this solver on `model` at `speed_rpm`: the fixed count,
+    /// or the one [`StepsPerDelay::Auto`] picks there.
+    pub fn steps_at(&self, model: &ModalModel, speed_rpm: f64) -> NonZeroUsize {
         let tau = model.operation().delay_s(speed_rpm);
         let cutting_time: f64 = segments(model, speed_rpm, tau)
             .iter()
             .filter(|s| s.2)
             .map(|s| s.1 - s.0)
             .sum();
-        Ok(self.with_steps(self.cutting_steps(model, cutting_time)?))
+        self.cutting_steps(model, cutting_time)
     }
 
     /// Cutting steps per delay for a delay that cuts during `cutting_time` seconds.
-    pub(crate) fn cutting_steps(&self, model: &ModalModel, cutting_time: f64) -> Result<usize> {
+    pub(crate) fn cutting_steps(&self, model: &ModalModel, cutting_time: f64) -> NonZeroUsize {
         match self.steps {
-            StepsPerDelay::Fixed(0) => Err(StabilityError::InvalidInput {
-                field: "steps_per_delay",
-                value: 0.0,
-                expected: "at least 1 step",
-            }),
-            StepsPerDelay::Fixed(m) => Ok(m),
+            StepsPerDelay::Fixed(m) => m,
             StepsPerDelay::Auto => {
                 let f_max = model
                     .modes()
                     .iter()
                     .map(|m| m.frequency_hz())
                     .fold(0.0, f64::max);
-                Ok(AUTO_MIN_STEPS
-                    .max((AUTO_STEPS_PER_CYCLE * cutting_time * f_max).ceil() as usize))
+                steps_at_least(
+                    (AUTO_STEPS_PER_CYCLE * cutting_time * f_max).ceil() as usize,
+                    AUTO_MIN_STEPS,
+                )
             }
         }
     }
@@ -559,8 +582,8 @@ mod tests {
             (examples::schmitz_2023_milling(), 6000.0, 1.0e-3),
         ] {
             for method in [
-                Discretization::full().with_steps(40),
-                Discretization::semi().with_steps(40),
+                Discretization::full().with_steps(steps::<40>()),
+                Discretization::semi().with_steps(steps::<40>()),
             ] {
                 let op = method.monodromy(&model, rpm, b).unwrap();
                 let fast = op.dominant_eigenvalue().unwrap();
@@ -584,8 +607,8 @@ mod tests {
             (examples::ahmadi_2022_turning(), 7150.0, 2.286e-3),
         ] {
             for method in [
-                Discretization::full().with_steps(30),
-                Discretization::semi().with_steps(30),
+                Discretization::full().with_steps(steps::<30>()),
+                Discretization::semi().with_steps(steps::<30>()),
             ] {
                 let op = method.monodromy(&model, rpm, b).unwrap();
                 let d = op.dimension();

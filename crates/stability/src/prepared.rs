@@ -39,11 +39,12 @@ use crate::boundary::{
 };
 use crate::error::{Result, StabilityError};
 use crate::frequency_domain::FrequencyDomain;
-use crate::monodromy::{Discretization, Monodromy, Scheme, StepPlan, StepsPerDelay};
+use crate::monodromy::{Discretization, Monodromy, Scheme, StepPlan, StepsPerDelay, steps};
 use crate::multiplier::DominantMultiplier;
 use crate::zero_order::{PreparedZeroOrder, ZeroOrderOptions};
 use chatter_dynamics::{ModalModel, Operation};
 use chatter_progress::Observer;
+use std::num::NonZeroUsize;
 use std::sync::Mutex;
 
 /// A stability method by name.
@@ -257,22 +258,22 @@ impl PreparedDiscretization {
     /// The discretization with the step count fixed for `speed_rpm`: the automatic resolution
     /// on the grid's model, times [`SEMI_PROCESS_DAMPING_REFINEMENT`] for SDM on a model with
     /// process damping.
-    pub fn at_speed(&self, speed_rpm: f64) -> Result<Discretization> {
+    pub fn at_speed(&self, speed_rpm: f64) -> Discretization {
         let resolved = self
             .discretization
-            .resolved(self.grid.as_ref().unwrap_or(&self.model), speed_rpm)?;
+            .resolved(self.grid.as_ref().unwrap_or(&self.model), speed_rpm);
         let refined = self.discretization.steps == StepsPerDelay::Auto
             && self.discretization.scheme == Scheme::Semi
             && self
                 .model
                 .process_damping_n_per_m()
                 .is_some_and(|c| c > 0.0);
-        Ok(match resolved.steps {
+        match resolved.steps {
             StepsPerDelay::Fixed(m) if refined => {
-                resolved.with_steps(SEMI_PROCESS_DAMPING_REFINEMENT * m)
+                resolved.with_steps(m.saturating_mul(SEMI_PROCESS_DAMPING_REFINEMENT))
             }
             _ => resolved,
-        })
+        }
     }
 }
 
@@ -283,7 +284,9 @@ impl PreparedDiscretization {
     /// grid per speed).
     fn finer(&self, coarse: &Discretization) -> Option<Discretization> {
         match (self.discretization.steps, coarse.steps, &self.grid) {
-            (StepsPerDelay::Auto, StepsPerDelay::Fixed(m), None) => Some(coarse.with_steps(2 * m)),
+            (StepsPerDelay::Auto, StepsPerDelay::Fixed(m), None) => {
+                Some(coarse.with_steps(m.saturating_mul(steps::<2>())))
+            }
             _ => None,
         }
     }
@@ -311,7 +314,7 @@ fn extrapolated(coarse: &DominantMultiplier, fine: &DominantMultiplier) -> Domin
 /// reference itself 0.29 % high at 300 rpm: -0.37 %). The velocity term itself is integrated
 /// exactly over each step (A_0 + A(t) frozen at its step mean); the slow part is the delayed
 /// term at the ~45 vibration cycles per delay of such low speeds.
-pub const SEMI_PROCESS_DAMPING_REFINEMENT: usize = 2;
+pub const SEMI_PROCESS_DAMPING_REFINEMENT: NonZeroUsize = steps::<2>();
 
 /// Largest relative shift of the limiting depth from the coarse to the fine grid that one secant
 /// step (with the coarse grid's slope) resolves; beyond it (e.g. another lobe takes over on the
@@ -330,7 +333,7 @@ impl PreparedSolver for PreparedDiscretization {
     /// At the automatic resolution (own grid), the Richardson extrapolation of the grids of m
     /// and 2m steps (see [`Self::limiting_depth`]).
     fn dominant_multiplier(&self, speed_rpm: f64, depth_m: f64) -> Result<DominantMultiplier> {
-        let coarse = self.at_speed(speed_rpm)?;
+        let coarse = self.at_speed(speed_rpm);
         let mu = coarse.dominant_multiplier(&self.model, speed_rpm, depth_m)?;
         match self.finer(&coarse) {
             Some(fine) => Ok(extrapolated(
@@ -346,7 +349,7 @@ impl PreparedSolver for PreparedDiscretization {
         speed_rpm: f64,
         depth_m: f64,
     ) -> Result<(DominantMultiplier, f64)> {
-        let coarse = self.at_speed(speed_rpm)?;
+        let coarse = self.at_speed(speed_rpm);
         let Some(fine) = self.finer(&coarse) else {
             return coarse.chatter_frequency_hz(&self.model, speed_rpm, depth_m);
         };
@@ -367,7 +370,7 @@ impl PreparedSolver for PreparedDiscretization {
     /// per speed. Exception: at a crossing of two lobes (5500 rpm there: 1.1 %) the coarse grids
     /// may put the other lobe lowest, and the dominant lobe alone is extrapolated.
     fn limiting_depth(&self, speed_rpm: f64) -> Result<LobePoint> {
-        let coarse = self.at_speed(speed_rpm)?;
+        let coarse = self.at_speed(speed_rpm);
         let solver = WarmStarted::new(&coarse, &self.model, speed_rpm, None)?;
         let guess_m = guess(self.guide.as_ref(), speed_rpm);
         let Some(fine) = self.finer(&coarse) else {
@@ -598,7 +601,7 @@ mod tests {
             ..options
         };
         let reference = limiting_depth(
-            &Discretization::semi().with_steps(1600),
+            &Discretization::semi().with_steps(steps::<1600>()),
             &model,
             12_500.0,
             &fine,
@@ -631,7 +634,7 @@ mod tests {
         let flexure = examples::process_damping_flexure(Some(2.5e5));
         let mill = examples::schmitz_2023_milling();
         for (model, speed) in [(&flexure, 300.0), (&flexure, 2000.0), (&mill, 6960.0)] {
-            let fixed = Discretization::full().resolved(model, speed).unwrap();
+            let fixed = Discretization::full().resolved(model, speed);
             let prepared = PreparedDiscretization::new(fixed, model, &options).unwrap();
             let guided = PreparedSolver::limiting_depth(&prepared, speed).unwrap();
             let scanned = limiting_depth(&fixed, model, speed, &options).unwrap();
@@ -661,7 +664,7 @@ mod tests {
         let options = BoundaryOptions::default();
         let prepared =
             PreparedDiscretization::new(Discretization::full(), &nominal, &options).unwrap();
-        let at = prepared.at_speed(300.0).unwrap();
+        let at = prepared.at_speed(300.0);
         let modes = nominal
             .modes()
             .iter()
@@ -674,6 +677,6 @@ mod tests {
         let on_nominal = PreparedDiscretization::new(Discretization::full(), &stiffer, &options)
             .unwrap()
             .on_grid_of(&nominal);
-        assert_eq!(on_nominal.at_speed(300.0).unwrap(), at);
+        assert_eq!(on_nominal.at_speed(300.0), at);
     }
 }

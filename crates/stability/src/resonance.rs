@@ -225,6 +225,7 @@ impl Discretization {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::monodromy::steps;
     use chatter_dynamics::examples;
 
     /// Against the dense eigenvalues: the largest eigenvalue away from the harmonics, an
@@ -242,7 +243,7 @@ mod tests {
             (&flexure, 300.0, 6e-3),
         ] {
             let op = Discretization::semi()
-                .with_steps(60)
+                .with_steps(steps::<60>())
                 .monodromy(model, rpm, depth_m)
                 .unwrap();
             let values = op.dense().complex_eigenvalues();

@@ -211,7 +211,7 @@ pub fn eigenvalue_sensitivity(
     depth_m: f64,
 ) -> Result<EigenvalueSensitivity> {
     // one grid for the nominal and every perturbed model
-    let method = method.resolved(model, speed_rpm)?;
+    let method = method.resolved(model, speed_rpm);
     let p = parameters.len();
     let h = THETA_STEP;
     let operator = |shifts: &[(usize, f64)]| -> Result<Monodromy> {
@@ -301,6 +301,7 @@ pub fn eigenvalue_sensitivity(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::monodromy::steps;
     use chatter_dynamics::examples;
 
     fn mu_at(
@@ -330,7 +331,7 @@ mod tests {
             .iter()
             .map(|s| s.parse().unwrap())
             .collect();
-        let method = Discretization::full().with_steps(60);
+        let method = Discretization::full().with_steps(steps::<60>());
         let (rpm, b) = (7150.0, 2.0e-3);
         let s = eigenvalue_sensitivity(method, &model, &params, rpm, b).unwrap();
         let hs = 1e-3;
@@ -384,7 +385,7 @@ mod tests {
                 .iter()
                 .map(|s| s.parse().unwrap())
                 .collect();
-            let method = Discretization::full().with_steps(40);
+            let method = Discretization::full().with_steps(steps::<40>());
             let b = mm * 1e-3;
             // the derivative of the dominant eigenvalue exists where it is simple and separated
             // in modulus from the next one (not at lobe cusps, where two pairs cross)

@@ -258,7 +258,7 @@ impl StepPlan {
         let tau = model.operation().delay_s(speed_rpm);
         let segs = segments(model, speed_rpm, tau);
         let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
-        let m_cut = method.cutting_steps(model, cutting_time)?;
+        let m_cut = method.cutting_steps(model, cutting_time).get();
         let omegas = model.omegas_rad_s();
         let zetas = model.damping_ratios();
         let mut a0 = DMatrix::zeros(d, d);

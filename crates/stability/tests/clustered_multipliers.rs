@@ -10,7 +10,7 @@ use chatter_dynamics::{ModalModel, examples};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
 use chatter_stability::frequency_domain::FrequencyDomain;
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 
 /// det D(lambda) of the characteristic equation on the real axis, 2 x 2 in modal coordinates:
 /// D = lambda^2 I + 2 Z Omega lambda + Omega^2 + b W (1 - e^{-lambda tau}) + lambda b P with
@@ -73,7 +73,7 @@ fn lathe_with_process_damping_at_low_speed() {
         }
         let expected = (0.5 * (lo + hi) * tau).exp();
         let op = Discretization::semi()
-            .with_steps(3364)
+            .with_steps(steps::<3364>())
             .monodromy(&model, speed, depth_m)
             .unwrap();
         assert_eq!(op.dimension(), 6732);
@@ -94,7 +94,7 @@ fn lathe_with_process_damping_at_low_speed() {
         );
         if depth_m == 0.015 {
             let coarse = Discretization::semi()
-                .with_steps(420)
+                .with_steps(steps::<420>())
                 .monodromy(&model, speed, depth_m)
                 .unwrap()
                 .dense();
@@ -147,7 +147,7 @@ fn flexure_at_300_rpm_matches_dense_eigenvalues() {
 fn dominant_root_survives_a_failed_continuation() {
     let model = examples::proving_ground_lathe(None);
     let speed = 2300.0;
-    let fdm = Discretization::full().with_steps(4000);
+    let fdm = Discretization::full().with_steps(steps::<4000>());
     let limit = limiting_depth(&fdm, &model, speed, &BoundaryOptions::default())
         .unwrap()
         .depth_m;

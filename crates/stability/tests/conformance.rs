@@ -20,11 +20,10 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::{
-    CuttingCoefficients, Milling, MillingDirection, ModalModel, Mode, ModeShape, Operation,
-    Turning, examples,
+    CuttingCoefficients, ModalModel, Mode, ModeShape, Operation, Turning, examples,
 };
 use chatter_stability::boundary::{self, BoundaryOptions};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps, steps_at_least};
 use chatter_stability::prepared::{Method, PreparedFrequencyDomain, PreparedSolver};
 use std::f64::consts::PI;
 
@@ -111,32 +110,7 @@ fn problem_model(problem: Problem) -> ModalModel {
     match problem {
         Problem::SdofFull => examples::insperger_benchmark(1.0),
         Problem::SdofFivePercent => examples::insperger_benchmark(0.05),
-        Problem::TwoDofMilling => {
-            let mode = |f, k, coordinate| {
-                Mode::new(
-                    f,
-                    0.03,
-                    ModeShape::Directional {
-                        coordinate,
-                        stiffness_n_per_m: k,
-                    },
-                )
-                .unwrap()
-            };
-            ModalModel::new(
-                Some("issue 14 mill".into()),
-                Operation::Milling(
-                    Milling::new(3, 0.75, MillingDirection::Down, Some(12.7e-3), None).unwrap(),
-                ),
-                CuttingCoefficients::new(700e6, 210e6).unwrap(),
-                vec![
-                    mode(918.817_583_621_353_3, 7_815_703.869_117_313, 0),
-                    mode(889.340_042_863_237, 7_516_307.737_741_677, 1),
-                ],
-                None,
-            )
-            .unwrap()
-        }
+        Problem::TwoDofMilling => examples::issue_14_mill(),
         Problem::Turning => ModalModel::new(
             Some("single-DOF lathe".into()),
             Operation::Turning(Turning::new(Some(0.038)).unwrap()),
@@ -227,7 +201,7 @@ fn reference_depth_m(problem: Problem, model: &ModalModel, speed_rpm: f64) -> f6
         .fold(0.0, f64::max);
     let (entry, exit) = m.entry_exit_rad();
     let cutting_s = (exit - entry) / (2.0 * PI) * 60.0 / speed_rpm;
-    let steps = ((60.0 * f_max * cutting_s).ceil() as usize).max(400);
+    let steps = steps_at_least((60.0 * f_max * cutting_s).ceil() as usize, steps::<400>());
     let options = BoundaryOptions {
         relative_tolerance: 1e-6,
         ..Default::default()

@@ -22,7 +22,7 @@
 use chatter_dynamics::examples;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth, limiting_depth_near};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use std::f64::consts::PI;
 
 const C_N_PER_M: f64 = 2.5e5;
@@ -121,8 +121,8 @@ fn time_domain_multiplier(
 fn discretizations_with_process_damping_match_time_domain() {
     let model = examples::process_damping_flexure(Some(C_N_PER_M));
     let options = BoundaryOptions::default();
-    let fdm = Discretization::full().with_steps(1600);
-    let sdm = Discretization::semi().with_steps(3200);
+    let fdm = Discretization::full().with_steps(steps::<1600>());
+    let sdm = Discretization::semi().with_steps(steps::<3200>());
     for (speed, delays) in [(300.0, 600), (1000.0, 400), (3000.0, 400)] {
         let limit = limiting_depth(&fdm, &model, speed, &options).unwrap();
         let sdm_limit =
@@ -156,4 +156,53 @@ fn discretizations_with_process_damping_match_time_domain() {
             }
         }
     }
+}
+
+/// Issue 14's process-damping criterion, met by switching the samplers: the solver every
+/// sampler prepares by default ([`SolverOptions::default`], full discretization at the
+/// automatic resolution on the nominal model's grid, as the 003 paths and 004 cut likelihoods
+/// run it) is within 3 % of the converged limit on the 003-type flexure from 300 to 3000 rpm.
+/// The reference is FDM at 1600 cutting steps (at least 120 per vibration cycle), searched from
+/// zero depth to 1e-6: the grid that matches the time-domain integration above. The zero-order
+/// method is not used by the samplers there; its error is printed for the record (42 % low at
+/// 300 rpm when this was written).
+#[test]
+fn sampler_solver_within_three_percent_with_process_damping() {
+    use chatter_stability::monodromy::steps_at_least;
+    use chatter_stability::prepared::{Method, SolverOptions};
+    let model = examples::process_damping_flexure(Some(C_N_PER_M));
+    let options = SolverOptions::default();
+    assert_eq!(options.method, Method::Fdm, "the samplers' default method");
+    let sampler = options.prepare_on_grid_of(&model, &model).unwrap();
+    let zoa = SolverOptions::new(Method::Zoa)
+        .prepare_on_grid_of(&model, &model)
+        .unwrap();
+    let fine = BoundaryOptions {
+        relative_tolerance: 1e-6,
+        ..BoundaryOptions::default()
+    };
+    let mut worst: f64 = 0.0;
+    for speed in [
+        300.0, 400.0, 500.0, 700.0, 1000.0, 1500.0, 2000.0, 2500.0, 3000.0,
+    ] {
+        // 50 % up milling, one tooth: the cut lasts a quarter of the revolution
+        let cycles = FREQUENCY_HZ * 0.25 * 60.0 / speed;
+        let reference = Discretization::full().with_steps(steps_at_least(
+            (120.0 * cycles).ceil() as usize,
+            steps::<1600>(),
+        ));
+        let converged = limiting_depth(&reference, &model, speed, &fine)
+            .unwrap()
+            .depth_m;
+        let error = (sampler.limiting_depth(speed).unwrap().depth_m - converged) / converged;
+        let zoa_error = (zoa.limiting_depth(speed).unwrap().depth_m - converged) / converged;
+        eprintln!(
+            "{speed} rpm: converged {:.4} mm, sampler's FDM {:+.2} %, zero-order {:+.1} %",
+            converged * 1e3,
+            100.0 * error,
+            100.0 * zoa_error
+        );
+        worst = worst.max(error.abs());
+    }
+    assert!(worst < 0.03, "worst {:.2} %", 100.0 * worst);
 }

@@ -4,7 +4,7 @@
 use chatter_dynamics::examples;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::{BoundaryOptions, limiting_depth};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::zero_order::zoa_lobes;
 
 fn local_extrema(points: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>) {
@@ -63,9 +63,9 @@ fn fdm_and_sdm_converge_together() {
         (0.05, 20000.0),
     ] {
         let model = examples::insperger_benchmark(ad);
-        let gaps: Vec<f64> = [20, 40, 80, 160]
-            .iter()
-            .map(|&m| {
+        let gaps: Vec<f64> = [steps::<20>(), steps::<40>(), steps::<80>(), steps::<160>()]
+            .into_iter()
+            .map(|m| {
                 let f = limiting_depth(&Discretization::full().with_steps(m), &model, rpm, &opts);
                 let s = limiting_depth(&Discretization::semi().with_steps(m), &model, rpm, &opts);
                 let (f, s) = (f.unwrap().depth_m, s.unwrap().depth_m);
@@ -86,8 +86,13 @@ fn default_resolution_within_two_percent() {
         let model = examples::insperger_benchmark(ad);
         for rpm in [5000.0, 9000.0, 13000.0, 17000.0, 21000.0, 25000.0] {
             let auto = limiting_depth(&Discretization::full(), &model, rpm, &opts).unwrap();
-            let fine = limiting_depth(&Discretization::semi().with_steps(400), &model, rpm, &opts)
-                .unwrap();
+            let fine = limiting_depth(
+                &Discretization::semi().with_steps(steps::<400>()),
+                &model,
+                rpm,
+                &opts,
+            )
+            .unwrap();
             let err = (auto.depth_m - fine.depth_m).abs() / fine.depth_m;
             assert!(err < 0.02, "a/D {ad} {rpm} rpm: {err}");
         }

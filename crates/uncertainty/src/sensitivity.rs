@@ -23,12 +23,13 @@
 use crate::error::{Result, UncertaintyError};
 use chatter_dynamics::{ModalModel, Operation, Parameter};
 use chatter_stability::StabilitySolver;
-use chatter_stability::monodromy::{Discretization, StepsPerDelay};
+use chatter_stability::monodromy::{Discretization, steps};
 use num_complex::Complex64;
 use std::f64::consts::PI;
+use std::num::NonZeroUsize;
 
 /// Steps per revolution of the sensitivities of 000 Table 3.
-pub const TABLE3_STEPS_PER_REVOLUTION: usize = 200;
+pub const TABLE3_STEPS_PER_REVOLUTION: NonZeroUsize = steps::<200>();
 
 /// Which map's dominant eigenvalue is differentiated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -81,7 +82,7 @@ pub fn pole_sensitivity(
     parameters: &[Parameter],
     speed_rpm: f64,
     depth_m: f64,
-    steps_per_delay: usize,
+    steps_per_delay: NonZeroUsize,
     map: TransitionMap,
 ) -> Result<PoleSensitivity> {
     if parameters.is_empty() {
@@ -100,10 +101,7 @@ pub fn pole_sensitivity(
         });
     }
     let method = Discretization::full().with_steps(steps_per_delay);
-    let m = match method.resolved(model, speed_rpm)?.steps {
-        StepsPerDelay::Fixed(m) => m,
-        StepsPerDelay::Auto => steps_per_delay,
-    };
+    let m = steps_per_delay.get();
     let s = chatter_stability::sensitivity::eigenvalue_sensitivity(
         method, model, parameters, speed_rpm, depth_m,
     )?;
@@ -195,7 +193,14 @@ mod tests {
     fn milling_has_no_one_step_map() {
         let model = examples::schmitz_2023_milling();
         let p: Parameter = "theta_omega_1".parse().unwrap();
-        let e = pole_sensitivity(&model, &[p], 6000.0, 1e-3, 40, TransitionMap::OneStep);
+        let e = pole_sensitivity(
+            &model,
+            &[p],
+            6000.0,
+            1e-3,
+            steps::<40>(),
+            TransitionMap::OneStep,
+        );
         assert!(e.is_err());
     }
 }

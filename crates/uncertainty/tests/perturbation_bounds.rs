@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::{Parameter, examples};
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::sensitivity::eigenvalue_sensitivity;
 use chatter_uncertainty::perturbation::{EigenSensitivity, model_moment_grid, moments};
 use nalgebra::DMatrix;
@@ -32,7 +32,7 @@ fn moments_match_monte_carlo_and_widen() {
     let model = examples::ahmadi_2022_turning();
     let (params, eq34) = (mode2_parameters(), eq34());
     let sigma = &eq34 * 0.1;
-    let method = Discretization::full().with_steps(60);
+    let method = Discretization::full().with_steps(steps::<60>());
     let (rpm, mm) = (7150.0, 2.0);
     let grid = model_moment_grid(method, &model, &params, &sigma, &[rpm], &[mm, 2.2]).unwrap();
     let m = grid.moments[0][0];

@@ -17,7 +17,7 @@
 use chatter_dynamics::{Cut, ModeShape, examples};
 use chatter_progress::Silent;
 use chatter_stability::boundary;
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps, steps_at_least};
 use chatter_updating::cuts::CutKernel;
 use chatter_updating::karandikar::{self, PAPER_PRIOR_P_STABLE, PAPER_PRIOR_SD_C};
 
@@ -140,7 +140,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for speed in [300.0, 500.0, 700.0, 900.0, 1100.0, 1300.0] {
         // 50 % immersion, one tooth: the cut lasts half the revolution
         let cycles: f64 = 228.0 * 0.5 * 60.0 / speed;
-        let steps = ((60.0 * cycles).ceil() as usize).max(400);
+        let steps = steps_at_least((60.0 * cycles).ceil() as usize, steps::<400>());
         let options = boundary::BoundaryOptions {
             relative_tolerance: 1e-5,
             max_depth_m: 0.1,

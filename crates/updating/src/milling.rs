@@ -129,7 +129,7 @@ impl MillingPoleLikelihood {
                     speed_rpm: p.speed_rpm,
                     depth_m: p.depth_mm * 1e-3,
                     radial_immersion: p.radial_immersion,
-                    solver: discretization.resolved(&model, p.speed_rpm)?,
+                    solver: discretization.resolved(&model, p.speed_rpm),
                     repetitions: n,
                     frequency_hz: p.frequency_hz,
                     damping_ratio: p.damping_ratio,
@@ -257,13 +257,14 @@ mod tests {
     use super::*;
     use crate::parameters::parse_model_parameters;
     use chatter_dynamics::examples;
+    use chatter_stability::monodromy::steps;
 
     fn setup(alpha: f64) -> (MillingPoleLikelihood, Vec<PoleObservation>) {
         // poles "identified" on a model with 2 % higher natural frequency, no scatter
         let nominal = examples::ebrahimi_2025_milling();
         let params = parse_model_parameters("theta_omega_1,theta_zeta_1").unwrap();
         let p = Parameterization::new(nominal, params).unwrap();
-        let solver = Discretization::full().with_steps(30);
+        let solver = Discretization::full().with_steps(steps::<30>());
         let truth = p.model(&[0.02, 0.5]).unwrap();
         let poles: Vec<PoleObservation> = [(2100.0, 0.3), (2200.0, 0.5)]
             .iter()

@@ -19,7 +19,7 @@
 use chatter_dynamics::{Cut, ModalModel, examples};
 use chatter_progress::Silent;
 use chatter_stability::boundary;
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps, steps_at_least};
 use chatter_stability::prepared::Method;
 use chatter_stability::prepared::SolverOptions;
 use chatter_updating::cuts::CutKernel;
@@ -47,7 +47,7 @@ impl Machine {
         let limit = *self.limits.entry(speed_rpm.to_bits()).or_insert_with(|| {
             // 50 % immersion, one tooth: the cut lasts half of the delay 60 / n
             let cycles = 228.0 * 0.5 * 60.0 / speed_rpm;
-            let steps = ((60.0 * cycles).ceil() as usize).max(400);
+            let steps = steps_at_least((60.0 * cycles).ceil() as usize, steps::<400>());
             let options = boundary::BoundaryOptions {
                 relative_tolerance: 1e-5,
                 ..Default::default()

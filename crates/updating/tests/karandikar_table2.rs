@@ -46,11 +46,15 @@ fn table_2_candidates_match_the_paper() {
 fn rss_recovers_the_process_damping_coefficient() {
     use chatter_dynamics::Cut;
     use chatter_stability::boundary;
-    use chatter_stability::monodromy::Discretization;
+    use chatter_stability::monodromy::{Discretization, steps_at_least};
+    use std::num::NonZeroUsize;
     let model = examples::karandikar_flexure();
     let mut cuts = Vec::new();
     for speed in [500.0, 700.0, 900.0] {
-        let steps = (4.0 * 228.0 * 0.5 * 60.0 / speed * 24.0) as usize;
+        let steps = steps_at_least(
+            (4.0 * 228.0 * 0.5 * 60.0 / speed * 24.0) as usize,
+            NonZeroUsize::MIN,
+        );
         let limit = boundary::limiting_depth(
             &Discretization::full().with_steps(steps),
             &model,

@@ -17,7 +17,7 @@ use chatter_dynamics::{
 };
 use chatter_progress::Silent;
 use chatter_stability::boundary::BoundaryOptions as SearchOptions;
-use chatter_stability::monodromy::Discretization;
+use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::prepared::SolverOptions;
 use chatter_stability::prepared::{PreparedDiscretization, PreparedSolver};
 use chatter_updating::cuts::CutKernel;
@@ -63,7 +63,7 @@ fn risk_based_selection_reaches_the_best_stable_mrr() {
     let speeds: Vec<f64> = (0..17).map(|i| 8000.0 + 1000.0 * i as f64).collect();
     let depths: Vec<f64> = (1..=80).map(|i| i as f64 * 0.1e-3).collect();
     let true_lobes = PreparedDiscretization::new(
-        Discretization::semi().with_steps(150),
+        Discretization::semi().with_steps(steps::<150>()),
         &truth,
         &SearchOptions::default(),
     )
