@@ -271,3 +271,48 @@ fn update_with_the_correlated_prior_matches_importance_reweighted_prior_draws() 
     assert!(is_mean[beta] - prior_mean[beta] > 0.5 * prior_cov[beta][beta].sqrt());
     assert!(post_cov[beta][beta].sqrt() < 0.8 * prior_cov[beta][beta].sqrt());
 }
+
+/// 004 Sec. 6 replayed with few paths (the demo and the example use 100 and 200): every
+/// sequence stops by the paper's 10 % rule or the cap, its final MRR is its best stable test's,
+/// every unstable test carries a chatter frequency, and the rows are within their tolerances
+/// (`replay_rows`).
+#[test]
+fn sec6_replayed_sequences_stop_by_the_rules_and_match_the_paper() {
+    use chatter_updating::plan::MRR_STOP_IMPROVEMENT;
+    use chatter_updating::schmitz2022::{REPLAY_MAX_TESTS, replay_reproduction, replay_table};
+    let (replays, rows) = replay_reproduction(REPLAY_PATHS, 4, &Silent).unwrap();
+    for r in &replays {
+        println!("{}", replay_table(r));
+        let best = r.final_mrr_cm3_per_min;
+        let capped = r.tests.len() == REPLAY_MAX_TESTS;
+        let small_gain = matches!(
+            (r.last_proposal.and_then(|p| p.mrr_cm3_per_min), best),
+            (Some(next), Some(best)) if next < (1.0 + MRR_STOP_IMPROVEMENT) * best
+        );
+        assert!(capped || small_gain, "{}", r.stop_reason);
+        // the best stable test is the final MRR
+        let stable_best = r
+            .tests
+            .iter()
+            .filter(|t| t.stable)
+            .filter_map(|t| t.plan.mrr_cm3_per_min)
+            .fold(f64::NAN, f64::max);
+        assert_eq!(best, Some(stable_best));
+        // an unstable test carries a chatter frequency, a stable one none
+        assert!(r.tests.iter().all(|t| t.stable == t.chatter_hz.is_none()));
+    }
+    println!("{}", table(&rows));
+    for r in &rows {
+        assert!(
+            r.within(),
+            "{}: paper {} ours {} (tolerance {})",
+            r.quantity,
+            r.paper,
+            r.ours,
+            r.tolerance
+        );
+    }
+}
+
+/// Posterior paths per plan of the replay test.
+const REPLAY_PATHS: usize = 60;
