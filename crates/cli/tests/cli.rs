@@ -777,9 +777,9 @@ fn update_takes_the_004_correlated_prior() {
     let cuts = dir.path().join("cuts.json");
     std::fs::write(
         &cuts,
-        r#"{"cuts": [{"speed_rpm": 10985, "depth_mm": 0.65, "stable": true},
-                     {"speed_rpm": 10985, "depth_mm": 0.7, "stable": false},
-                     {"speed_rpm": 10000, "depth_mm": 0.6, "stable": false}]}"#,
+        r#"{"cuts": [{"speed_rpm": 10985, "depth_mm": 2.8, "stable": true},
+                     {"speed_rpm": 10985, "depth_mm": 3.2, "stable": false},
+                     {"speed_rpm": 10000, "depth_mm": 1.2, "stable": false}]}"#,
     )
     .unwrap();
     let out_dir = dir.path().join("posterior");

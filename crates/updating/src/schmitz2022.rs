@@ -230,8 +230,8 @@ pub struct TruthMachine {
 impl TruthMachine {
     /// The prior-mean model with FDM (see the type docs); depths above 20 mm count as stable.
     pub fn prior_mean_fdm() -> Result<Self> {
-        let options = chatter_stability::prepared::SolverOptions::new(Method::Fdm)
-            .with_max_depth_m(20e-3);
+        let options =
+            chatter_stability::prepared::SolverOptions::new(Method::Fdm).with_max_depth_m(20e-3);
         Ok(Self {
             solver: options.prepare_on_grid_of(&model(), &model())?,
         })

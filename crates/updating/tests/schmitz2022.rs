@@ -131,17 +131,18 @@ fn update_with_the_correlated_prior_matches_importance_reweighted_prior_draws() 
 
     let model = model();
     let joint = chatter_updating::schmitz2022::prior().unwrap();
-    // three cuts at 10 985 rpm (the paper's first test speed): stable at 2.5 mm, chatter at
-    // 4.5 mm and a stable one at 3 mm; they speak to the limit at one speed, not to how the
-    // modal parameters co-vary
+    // four cuts around the mean boundary (zoa: 2.97 mm at 10 985 rpm, 1.85 mm at 10 000 rpm,
+    // 1.76 mm at 12 000 rpm): stable at 2.8 mm and chatter at 3.2 mm at 10 985 rpm (the
+    // paper's best speed), chatter below the mean limit at 10 000 rpm, stable above it at
+    // 12 000 rpm; they speak to the force model, not to how the modal parameters co-vary
     let cut =
         |speed_rpm: f64, depth_mm: f64, stable: bool| Cut::labelled(speed_rpm, depth_mm, stable);
     let observations = Observations {
         cuts: vec![
-            cut(10_985.0, 0.65, true),
-            cut(10_985.0, 0.7, false),
-            cut(10_000.0, 0.6, false),
-            cut(12_000.0, 0.4, true),
+            cut(10_985.0, 2.8, true),
+            cut(10_985.0, 3.2, false),
+            cut(10_000.0, 1.2, false),
+            cut(12_000.0, 2.2, true),
         ],
         ..Observations::default()
     };
