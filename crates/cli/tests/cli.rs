@@ -236,9 +236,11 @@ fn demo_writes_its_folder() {
     assert!(credibility.lines().any(|l| l.starts_with("7300,")));
     // 000 Table 3 (15), 001 Sec. 4 (15), 003 Table 2 (8); only D's reduction is outside
     // 000 Table 3 15, 001 Sec. 4 15, 002 Table 1 28 (at 194 Hz the 7 frequencies and at 195.3 Hz
-    // 5 damping ratios outside: documented), 003 Table 2 8 (D's reduction outside), 004 11
-    assert_eq!(summary["papers"]["rows"], 77);
-    assert_eq!(summary["papers"]["within_tolerance"], 64);
+    // 5 damping ratios outside: documented), 003 Table 2 8 (D's reduction outside), 004 11,
+    // 004 Sec. 6 replayed 8 (the 25 % final MRR, the 75 % test count and the ordering outside:
+    // documented in chatter_updating::schmitz2022)
+    assert_eq!(summary["papers"]["rows"], 85);
+    assert_eq!(summary["papers"]["within_tolerance"], 69);
 }
 
 #[test]
@@ -777,9 +779,9 @@ fn update_takes_the_004_correlated_prior() {
     let cuts = dir.path().join("cuts.json");
     std::fs::write(
         &cuts,
-        r#"{"cuts": [{"speed_rpm": 10985, "depth_mm": 0.65, "stable": true},
-                     {"speed_rpm": 10985, "depth_mm": 0.7, "stable": false},
-                     {"speed_rpm": 10000, "depth_mm": 0.6, "stable": false}]}"#,
+        r#"{"cuts": [{"speed_rpm": 10985, "depth_mm": 2.8, "stable": true},
+                     {"speed_rpm": 10985, "depth_mm": 3.2, "stable": false},
+                     {"speed_rpm": 10000, "depth_mm": 1.2, "stable": false}]}"#,
     )
     .unwrap();
     let out_dir = dir.path().join("posterior");

@@ -32,7 +32,7 @@ fn rcsa_writes_the_tip_frf_csv_and_plot() {
         lines.next(),
         Some("frequency_hz,real_m_per_n,imag_m_per_n,magnitude_m_per_n")
     );
-    assert_eq!(lines.count(), 1200);
+    assert_eq!(lines.count(), 300);
     assert!(std::fs::metadata(&svg).unwrap().len() > 1000);
 }
 

@@ -738,7 +738,7 @@ mod tests {
             .with_residuals([residual, chatter_dynamics::ResidualTerms::default()])
             .unwrap();
         let mut obs = Observations::default();
-        for (depth_mm, stable) in [(0.5, true), (1.0, false)] {
+        for (depth_mm, stable) in [(2.5, true), (3.5, false)] {
             obs.cuts.push(Cut::labelled(10_985.0, depth_mm, stable));
         }
         let options = SamplerOptions {
