@@ -4,6 +4,7 @@
 //! FDM at each sample's automatic resolution, extrapolated, as `chatter bands --kind
 //! montecarlo`).
 use chatter_dynamics::{Parameter, examples};
+use chatter_progress::Silent;
 use chatter_stability::boundary::{BoundaryOptions, speed_range};
 use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::prepared::{Method, SolverOptions};
@@ -27,7 +28,7 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("uncertainty");
     group.sample_size(10);
     group.bench_function("perturbation_grid_200x100_sdof_fdm_m40", |b| {
-        b.iter(|| model_moment_grid(fdm40, &model, &params, &sigma, &speeds, &depths))
+        b.iter(|| model_moment_grid(fdm40, &model, &params, &sigma, &speeds, &depths, &Silent))
     });
     let thetas = gaussian_draws(&[0.0; 3], &sigma, 1000, 1).unwrap_or_default();
     let mc_speeds = speed_range(5000.0, 25_000.0, 50).unwrap_or_default();

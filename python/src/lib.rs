@@ -26,28 +26,55 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// The observer of a Python call: silent, and cancelled once the caller was interrupted.
+/// The observer of a Python call: silent, and cancelled once the caller was interrupted. It
+/// counts the library's polls ([`OBSERVER_POLLS`]) and remembers whether the library was told to
+/// stop by one of them.
 #[derive(Default)]
-struct Interruptible(AtomicBool);
+struct Interruptible {
+    /// Set by the calling thread on Ctrl-C.
+    cancel: AtomicBool,
+    /// A poll of the library answered "cancelled".
+    seen: AtomicBool,
+}
 
 impl chatter_progress::Observer for Interruptible {
     fn cancelled(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
+        OBSERVER_POLLS.fetch_add(1, Ordering::Relaxed);
+        let cancel = self.cancel.load(Ordering::Relaxed);
+        if cancel {
+            self.seen.store(true, Ordering::Relaxed);
+        }
+        cancel
     }
 }
 
 /// Worker threads of calls still running (interrupted ones included until they return).
 static RUNNING_WORKERS: AtomicUsize = AtomicUsize::new(0);
 
-/// How long an interrupted call waits for its worker to stop. The libraries poll the
-/// cancellation between steps (a speed, a sample, a sampler move), so the worker normally
-/// returns within milliseconds; a call whose library does not poll (OMA, simulation) is left to
-/// finish in the background after this wait.
+/// Polls of the cancellation by the libraries of all calls so far: a library that has polled is
+/// inside its cancellable loop, what the interruption tests wait for before they interrupt.
+static OBSERVER_POLLS: AtomicUsize = AtomicUsize::new(0);
+
+/// Calls whose library stopped on a cancel: their worker returned after a poll had answered
+/// "cancelled" (counted when the worker returns).
+static CANCELS_SEEN: AtomicUsize = AtomicUsize::new(0);
+
+/// How long an interrupted call waits for its worker to stop before it raises
+/// `KeyboardInterrupt`. The libraries poll the cancellation between steps (a speed, a sample, a
+/// sampler move), so the worker normally returns within milliseconds; a worker that is slower
+/// (a long step on a loaded machine) finishes in the background after this wait, stopping at
+/// its next poll.
 const CANCEL_WAIT: Duration = Duration::from_secs(5);
 
+/// How often the calling thread checks for Ctrl-C while its worker runs.
+const SIGNAL_CHECK: Duration = Duration::from_millis(50);
+
 /// Run `work` on a worker thread with an observer that can cancel it; wait without the GIL,
-/// checking signals every 50 ms. On Ctrl-C the observer asks the library to stop, the call
-/// waits (up to [`CANCEL_WAIT`]) for the worker to return, and `KeyboardInterrupt` is raised.
+/// checking signals every [`SIGNAL_CHECK`]. Signals are checked before the worker's result is
+/// taken, also once it has finished, so that a Ctrl-C during the call is always raised by the
+/// call (never later, at whatever Python line runs next). On Ctrl-C the observer asks the
+/// library to stop, the call waits (up to [`CANCEL_WAIT`]) for the worker to return, and
+/// `KeyboardInterrupt` is raised.
 fn run_detached<T: Send + 'static>(
     py: Python<'_>,
     work: impl FnOnce(&dyn chatter_progress::Observer) -> T + Send + 'static,
@@ -57,18 +84,16 @@ fn run_detached<T: Send + 'static>(
     RUNNING_WORKERS.fetch_add(1, Ordering::SeqCst);
     let handle = std::thread::spawn(move || {
         let result = work(&*worker_observer);
+        if worker_observer.seen.load(Ordering::Relaxed) {
+            CANCELS_SEEN.fetch_add(1, Ordering::SeqCst);
+        }
         RUNNING_WORKERS.fetch_sub(1, Ordering::SeqCst);
         result
     });
     loop {
-        if handle.is_finished() {
-            return handle
-                .join()
-                .map_err(|_| PyRuntimeError::new_err("the chatter worker thread panicked"));
-        }
-        py.detach(|| std::thread::sleep(Duration::from_millis(50)));
+        let finished = handle.is_finished();
         if let Err(e) = py.check_signals() {
-            observer.0.store(true, Ordering::Relaxed);
+            observer.cancel.store(true, Ordering::Relaxed);
             py.detach(|| {
                 let start = Instant::now();
                 while !handle.is_finished() && start.elapsed() < CANCEL_WAIT {
@@ -81,14 +106,26 @@ fn run_detached<T: Send + 'static>(
                 PyKeyboardInterrupt::new_err("interrupted")
             });
         }
+        if finished {
+            return handle
+                .join()
+                .map_err(|_| PyRuntimeError::new_err("the chatter worker thread panicked"));
+        }
+        py.detach(|| std::thread::sleep(SIGNAL_CHECK));
     }
 }
 
-/// The number of worker threads of chatter calls still running; 0 right after an interrupted
-/// call whose library stopped on the cancel (what the tests check).
+/// What the interruption tests observe: `running_workers` (worker threads of calls still
+/// running; an interrupted call's until its library returns), `observer_polls` (polls of the
+/// cancellation by the libraries so far) and `cancels_seen` (calls whose library stopped on a
+/// cancel).
 #[pyfunction]
-fn _running_workers() -> usize {
-    RUNNING_WORKERS.load(Ordering::SeqCst)
+fn _interruption_counters(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("running_workers", RUNNING_WORKERS.load(Ordering::SeqCst))?;
+    d.set_item("observer_polls", OBSERVER_POLLS.load(Ordering::SeqCst))?;
+    d.set_item("cancels_seen", CANCELS_SEEN.load(Ordering::SeqCst))?;
+    Ok(d)
 }
 
 /// JSON text of a Python object (a dict) through the `json` module.
@@ -414,8 +451,8 @@ fn bands_perturbation<'py>(
         Some(c) => BoundRule::coverage(c).map_err(|e| value_error(format!("coverage: {e}")))?,
         None => BoundRule::ComplexSd,
     };
-    let p = run_detached(py, move |_| {
-        band_jobs::perturbation(&m, &dist, method, rule, &speeds, depths)
+    let p = run_detached(py, move |observer| {
+        band_jobs::perturbation(&m, &dist, method, rule, &speeds, depths, observer)
     })?
     .map_err(value_error)?;
     let d = PyDict::new(py);
@@ -710,15 +747,42 @@ fn oma_observations<'py>(
     Ok(d)
 }
 
+/// Priors from a dict or a path (the `--priors` file of `chatter update` and `chatter plan`):
+/// marginals by name, or one correlated normal `{"parameter_names", "mean", "covariance"}` (004's
+/// RCSA prior), read by the same function as the command line's
+/// ([`chatter_updating::joint_prior::PriorFile::from_json_str`]).
 fn priors_of(
     priors: Option<&Bound<'_, PyAny>>,
-) -> PyResult<chatter_updating::update::PriorOverrides> {
-    match priors {
-        None => Ok(Default::default()),
-        Some(p) => {
-            serde_json::from_str(&json_text(p)?).map_err(|e| value_error(format!("priors: {e}")))
-        }
+) -> PyResult<(
+    chatter_updating::update::PriorOverrides,
+    Option<chatter_updating::joint_prior::JointNormal>,
+)> {
+    use chatter_updating::joint_prior::PriorFile;
+    let Some(p) = priors else {
+        return Ok(Default::default());
+    };
+    let (text, source) = if p.is_instance_of::<PyDict>() {
+        (json_text(p)?, "<priors dict>".to_string())
+    } else {
+        let path: PathBuf = p.extract()?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| value_error(format!("priors: reading {}: {e}", path.display())))?;
+        (text, path.display().to_string())
+    };
+    match PriorFile::from_json_str(&text).map_err(|e| {
+        value_error(format!(
+            "priors: {source}: {e} (expected marginals by name, or \
+             {{\"parameter_names\", \"mean\", \"covariance\"}})"
+        ))
+    })? {
+        PriorFile::Marginals(m) => Ok((m, None)),
+        PriorFile::Joint(j) => Ok((Default::default(), Some(j))),
     }
+}
+
+/// The stability method of a cut likelihood or of sampled boundaries; `None`: the default.
+fn optional_method(method: Option<&str>) -> PyResult<Option<Method>> {
+    method.map(method_of).transpose()
 }
 
 fn parameters_of(
@@ -734,9 +798,13 @@ fn parameters_of(
 /// Bayesian updating (the `chatter update` job): posterior samples of the selected class
 /// (`samples`, one row per draw, columns `parameter_names`), their `weights`, the
 /// classes with `log_evidence` (nats), `prior_draws` and, with `pointwise`, the log-likelihood
-/// of every observation at every sample (`log_likelihood`, nats), for ArviZ.
+/// of every observation at every sample (`log_likelihood`, nats), for ArviZ. `priors` as the
+/// `--priors` file (a dict or a path): marginals by name, or one correlated normal
+/// `{"parameter_names", "mean", "covariance"}` whose names are then the updated parameters
+/// unless `parameters` is given; `method` the stability method of a cut likelihood ("fdm",
+/// "sdm" or "zoa"; cut results only).
 #[pyfunction]
-#[pyo3(signature = (model, observations, seed, sampler="itmcmc", samples=5000, parameters=None, priors=None, classes=None, surrogate="gp", surrogate_points=chatter_updating::surrogate::DEFAULT_TRAINING_POINTS, pointwise=true))]
+#[pyo3(signature = (model, observations, seed, sampler="itmcmc", samples=5000, parameters=None, priors=None, classes=None, surrogate="gp", surrogate_points=chatter_updating::surrogate::DEFAULT_TRAINING_POINTS, pointwise=true, method=None))]
 #[allow(clippy::too_many_arguments)]
 fn update<'py>(
     py: Python<'py>,
@@ -751,6 +819,7 @@ fn update<'py>(
     surrogate: &str,
     surrogate_points: usize,
     pointwise: bool,
+    method: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use chatter_updating::classes::Sampler;
     let m = model_of(model)?;
@@ -768,7 +837,8 @@ fn update<'py>(
     };
     request.samples = samples;
     request.parameters = parameters_of(parameters)?;
-    request.priors = priors_of(priors)?;
+    (request.priors, request.joint_prior) = priors_of(priors)?;
+    request.method = optional_method(method)?;
     request.classes = classes;
     request.surrogate_points = match surrogate {
         "gp" => Some(surrogate_points),
@@ -826,9 +896,10 @@ fn update<'py>(
 }
 
 /// The next test cut (the `chatter plan` job): `strategy` "voi" (003) or "mrr" (004); speeds
-/// in rpm, depths and feed in mm.
+/// in rpm, depths and feed in mm; `priors` as in [`update`]; `method` the stability method of
+/// the sampled boundaries ("fdm", the default, "sdm" or "zoa").
 #[pyfunction]
-#[pyo3(signature = (model, observations, strategy="mrr", p_test=0.5, parameters=None, priors=None, target=None, paths=300, speeds_rpm=None, depths_mm=None, feed_per_tooth_mm=0.1, seed=0, max_tests=chatter_updating::plan::DEFAULT_MAX_TESTS))]
+#[pyo3(signature = (model, observations, strategy="mrr", p_test=0.5, parameters=None, priors=None, target=None, paths=300, speeds_rpm=None, depths_mm=None, feed_per_tooth_mm=0.1, seed=0, max_tests=chatter_updating::plan::DEFAULT_MAX_TESTS, method=None))]
 #[allow(clippy::too_many_arguments)]
 fn plan<'py>(
     py: Python<'py>,
@@ -845,6 +916,7 @@ fn plan<'py>(
     feed_per_tooth_mm: f64,
     seed: u64,
     max_tests: usize,
+    method: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     use chatter_updating::plan::Strategy;
     let m = model_of(model)?;
@@ -860,7 +932,8 @@ fn plan<'py>(
     });
     request.p_test = p_test;
     request.parameters = parameters_of(parameters)?;
-    request.priors = priors_of(priors)?;
+    (request.priors, request.joint_prior) = priors_of(priors)?;
+    request.method = optional_method(method)?;
     request.target = target.map(|t| t.parse().map_err(value_error)).transpose()?;
     request.paths = paths;
     request.speeds_rpm = speeds_rpm
@@ -1095,7 +1168,7 @@ fn _chatter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bands_geometric, m)?)?;
     m.add_function(wrap_pyfunction!(bands_perturbation, m)?)?;
     m.add_function(wrap_pyfunction!(bands_montecarlo, m)?)?;
-    m.add_function(wrap_pyfunction!(_running_workers, m)?)?;
+    m.add_function(wrap_pyfunction!(_interruption_counters, m)?)?;
     m.add_function(wrap_pyfunction!(oma_observations, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(detect, m)?)?;

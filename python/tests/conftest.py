@@ -12,6 +12,9 @@ EXAMPLES = REPO / "examples"
 TURNING_MODEL = EXAMPLES / "ahmadi2022_turning_model.json"
 TURNING_OBSERVATIONS = EXAMPLES / "ahmadi2022_turning_observations.json"
 MILLING_MODEL = EXAMPLES / "schmitz2023_milling_model.json"
+POSTERIOR_EQ34 = EXAMPLES / "ahmadi2022_posterior.json"
+RCSA_MODEL = EXAMPLES / "schmitz2022_rcsa_model.json"
+RCSA_PRIOR = EXAMPLES / "schmitz2022_rcsa_prior.json"
 
 
 def _find_cli():

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import chatter
-from conftest import MILLING_MODEL, TURNING_MODEL, TURNING_OBSERVATIONS
+from conftest import (MILLING_MODEL, POSTERIOR_EQ34, RCSA_MODEL, RCSA_PRIOR, TURNING_MODEL,
+                      TURNING_OBSERVATIONS)
 
 
 def read_csv(path):
@@ -176,6 +177,36 @@ def test_update_is_bit_identical_to_the_cli(seed000_update):
     assert same(summary["posterior_covariance"], py["posterior_covariance"])
 
 
+def test_update_with_the_004_correlated_prior_is_bit_identical_to_the_cli(cli, tmp_path):
+    """004's joint normal RCSA prior as a path and as a dict: its eight names are the updated
+    parameters, and the posterior equals `chatter update --priors FILE` bit for bit."""
+    cuts = {"cuts": [{"speed_rpm": 10985.0, "depth_mm": 0.65, "stable": True},
+                     {"speed_rpm": 10985.0, "depth_mm": 0.7, "stable": False},
+                     {"speed_rpm": 10000.0, "depth_mm": 0.6, "stable": False}]}
+    observations = tmp_path / "cuts.json"
+    observations.write_text(json.dumps(cuts))
+    out = tmp_path / "posterior"
+    cli("update", "--model", RCSA_MODEL, "--observations", observations, "--priors", RCSA_PRIOR,
+        "--method", "zoa", "--samples", 200, "--seed", 2, "--out", out)
+    rows = read_csv(out / "posterior.csv")
+    summary = json.loads((out / "summary.json").read_text())
+    prior = json.loads(RCSA_PRIOR.read_text())
+    for given in (RCSA_PRIOR, prior):
+        py = chatter.update(RCSA_MODEL, cuts, seed=2, samples=200, priors=given, method="zoa",
+                            pointwise=False)
+        names = py["parameter_names"]
+        assert names == prior["parameter_names"] == summary["parameter_names"]
+        assert same(np.array([[float(r[n]) for n in names] for r in rows]), py["samples"])
+        assert same(cells(rows, "weight"), py["weights"])
+        assert [c["log_evidence"] for c in summary["classes"]] == \
+            [c["log_evidence"] for c in py["classes"]]
+        assert same(summary["posterior_covariance"], py["posterior_covariance"])
+    # a prior naming a parameter the model does not have is refused naming it
+    bad = dict(prior, parameter_names=["no_such"] + prior["parameter_names"][1:])
+    with pytest.raises(ValueError, match="no_such"):
+        chatter.update(RCSA_MODEL, cuts, seed=2, samples=200, priors=bad, method="zoa")
+
+
 def test_montecarlo_and_perturbation_bands_are_bit_identical_to_the_cli(cli, seed000_update, tmp_path):
     posterior, _ = seed000_update
     speeds = np.linspace(6900.0, 7500.0, 4)
@@ -239,6 +270,14 @@ def _diagnose():
                                     validation="off", pointwise=False)
 
 
+def _perturbation():
+    # second-order bounds on 200 speeds x 100 depths: eigenvalue Hessians on 20 000 grid cells,
+    # minutes uninterrupted
+    return lambda: chatter.bands_perturbation(TURNING_MODEL, POSTERIOR_EQ34,
+                                              speeds_rpm=np.linspace(6800.0, 7600.0, 200),
+                                              depths_mm=np.linspace(1.5, 4.0, 100))
+
+
 def _simulate():
     # 60 s of turning at 20 kHz: several seconds uninterrupted
     return lambda: chatter.simulate(TURNING_MODEL, 7000.0, 0.1, duration_s=60.0,
@@ -253,13 +292,28 @@ def _oma():
     return lambda: chatter.oma(sim["data"][:2], sim["sample_rate_hz"], speed_rpm=7000.0)
 
 
-def _interrupt_once_started(done):
-    """A thread that raises Ctrl-C in the main thread as soon as a chatter call's worker runs,
-    so that the interrupt lands inside the call whatever the machine's load (a timer can fire
-    before the call starts or after it ends); it gives up once `done` is set."""
+def _counters():
+    return chatter._chatter._interruption_counters()
+
+
+def _wait_for(condition, what, timeout_s=600.0):
+    """Poll `condition` until it holds; fail naming `what` after `timeout_s` (a bound for a
+    machine loaded many times over, far above the milliseconds it takes when idle)."""
+    start = time.monotonic()
+    while not condition():
+        assert time.monotonic() - start < timeout_s, f"{what} after {timeout_s} s: {_counters()}"
+        time.sleep(0.01)
+
+
+def _interrupt_once_polling(done, polls_before):
+    """A thread that raises Ctrl-C in the main thread as soon as the call's library has polled
+    its cancellation once: the library is then inside its cancellable loop with nearly all of
+    its work (seconds to minutes) ahead, while the call sees the interrupt within its 50 ms
+    signal check, so the cancel lands inside the library whatever the machine's load (a timer
+    can fire before the call starts or after it ends). It gives up once `done` is set."""
 
     def watch():
-        while chatter._chatter._running_workers() == 0:
+        while _counters()["observer_polls"] == polls_before:
             if done.is_set():
                 return
             time.sleep(0.001)
@@ -270,16 +324,19 @@ def _interrupt_once_started(done):
     return thread
 
 
-@pytest.mark.parametrize("make", [_lobes, _update, _diagnose, _simulate, _oma],
-                         ids=["lobes", "update", "diagnose", "simulate", "oma"])
+@pytest.mark.parametrize("make", [_lobes, _update, _diagnose, _perturbation, _simulate, _oma],
+                         ids=["lobes", "update", "diagnose", "perturbation", "simulate", "oma"])
 def test_a_long_call_is_cancelled_inside_the_library_by_ctrl_c(make):
-    """Ctrl-C raises KeyboardInterrupt, and the library stopped: the call waits for its worker
-    after asking it to cancel, so no worker is left running (a library that did not poll the
-    cancel would keep its worker busy for seconds to minutes)."""
+    """Ctrl-C raises KeyboardInterrupt from the call, and the library stopped because of it: a
+    poll of its observer answered "cancelled" and its worker then returned (a library that did
+    not poll the cancel would keep its worker busy for seconds to minutes, and would not count
+    a cancel seen). Observed through the binding's counters, not through timing, so the test
+    holds on a loaded machine."""
     call = make()
-    assert chatter._chatter._running_workers() == 0
+    _wait_for(lambda: _counters()["running_workers"] == 0, "a worker of an earlier call runs")
+    before = _counters()
     done = threading.Event()
-    watcher = _interrupt_once_started(done)
+    watcher = _interrupt_once_polling(done, before["observer_polls"])
     try:
         with pytest.raises(KeyboardInterrupt):
             call()
@@ -287,7 +344,10 @@ def test_a_long_call_is_cancelled_inside_the_library_by_ctrl_c(make):
         # a watcher still waiting must not interrupt a later test
         done.set()
         watcher.join()
-    assert chatter._chatter._running_workers() == 0
+    # the call waits up to 5 s for its worker; on a loaded machine the library's current step
+    # can take longer, so the worker's return is awaited here
+    _wait_for(lambda: _counters()["running_workers"] == 0, "the cancelled worker still runs")
+    assert _counters()["cancels_seen"] == before["cancels_seen"] + 1, _counters()
 
 
 # --- ArviZ ----------------------------------------------------------------------------------

@@ -469,8 +469,11 @@ fn perturbation(
     };
     let dist = distribution(req, model)?;
     let method = discretized_method(req)?;
-    let bands = band_jobs::perturbation(model, &dist, method, rule, speeds, depth_option(req)?)
-        .map_err(crate::job_error)?;
+    let bar = Bar::new(speeds.len() as u64, "credibility grid", req.quiet);
+    let bands =
+        band_jobs::perturbation(model, &dist, method, rule, speeds, depth_option(req)?, &bar)
+            .map_err(crate::job_error)?;
+    bar.finish();
     let (csv, series) = credibility_bands(&bands.bounds, rule);
     emit(req.out, &csv)?;
     if req.plot.is_none() && req.report.is_none() {

@@ -468,6 +468,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         rule,
         &coarse,
         Some(depths),
+        &chatter_progress::Silent,
     )
     .map_err(crate::job_error)?;
     let (csv, series) = crate::bands::credibility_bands(&bands.bounds, rule);

@@ -106,7 +106,9 @@ pub struct PerturbationBands {
 
 /// Second-order credibility bounds (000 Eq. 14-18) of the model at the distribution's mean with
 /// the covariance about it, on `speeds_rpm` x `depths_mm` (default [`default_depths_mm`] of the
-/// mean model's lobes) under `rule`.
+/// mean model's lobes) under `rule`; `observer` hears of the speeds done (of those lobes first,
+/// when the depth grid is the default, then of the moment grid) and can stop both between
+/// speeds or grid cells.
 pub fn perturbation(
     model: &ModalModel,
     distribution: &ParameterDistribution,
@@ -114,17 +116,13 @@ pub fn perturbation(
     rule: BoundRule,
     speeds_rpm: &[f64],
     depths_mm: Option<Vec<f64>>,
+    observer: &dyn Observer,
 ) -> Result<PerturbationBands> {
     let discretization = discretization(method)?;
     let mean_model = distribution.mean_model(model)?;
     let depths_mm = match depths_mm {
         Some(d) => d,
-        None => default_depths_mm(&lobes(
-            &mean_model,
-            method,
-            speeds_rpm,
-            &chatter_progress::Silent,
-        )?)?,
+        None => default_depths_mm(&lobes(&mean_model, method, speeds_rpm, observer)?)?,
     };
     let grid = model_moment_grid(
         discretization,
@@ -133,6 +131,7 @@ pub fn perturbation(
         &distribution.covariance_about_mean(),
         speeds_rpm,
         &depths_mm,
+        observer,
     )?;
     let bounds = grid.bounds(rule);
     Ok(PerturbationBands {

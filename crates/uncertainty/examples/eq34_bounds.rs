@@ -29,6 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &sigma,
             &speeds_rpm,
             &depths_mm,
+            &chatter_progress::Silent,
         )?;
         for b in grid.bounds(chatter_uncertainty::perturbation::BoundRule::ComplexSd) {
             println!(

@@ -17,6 +17,9 @@ pub enum UncertaintyError {
     /// A sampled boundary could not be built (`chatter_updating::sampled`).
     #[error(transparent)]
     Updating(#[from] chatter_updating::UpdatingError),
+    /// The caller's observer asked to stop (`chatter_progress::Observer::cancelled`).
+    #[error(transparent)]
+    Cancelled(#[from] chatter_progress::Cancelled),
 }
 
 /// Result alias of this crate.

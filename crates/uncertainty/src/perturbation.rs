@@ -15,8 +15,10 @@
 //! boundary is then E|mu| = 1.
 
 use crate::error::{Result, UncertaintyError};
+use chatter_progress::Observer;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The dominant eigenvalue with its gradient and Hessian with respect to theta at theta = 0.
 #[derive(Debug, Clone, PartialEq)]
@@ -159,12 +161,14 @@ pub struct MomentGrid {
 
 impl MomentGrid {
     /// Evaluate `sensitivity(speed_rpm, depth_mm)` on the grid (in parallel over speeds) and
-    /// take Eq. 17-18 with `sigma`.
+    /// take Eq. 17-18 with `sigma`; `observer` hears of each speed done and is polled before
+    /// every cell ([`UncertaintyError::Cancelled`]).
     pub fn evaluate<F>(
         speeds_rpm: &[f64],
         depths_mm: &[f64],
         sigma: &DMatrix<f64>,
         sensitivity: F,
+        observer: &dyn Observer,
     ) -> Result<Self>
     where
         F: Fn(f64, f64) -> Result<EigenSensitivity> + Sync,
@@ -176,16 +180,21 @@ impl MomentGrid {
                 message: "at least two strictly increasing depths expected".into(),
             });
         }
+        let done = AtomicUsize::new(0);
         let rows = speeds_rpm
             .par_iter()
             .map(|&s| {
-                depths_mm
+                let row = depths_mm
                     .iter()
                     .map(|&b| {
+                        chatter_progress::check(observer)?;
                         let e = sensitivity(s, b)?;
                         Ok((moments(&e, sigma)?, modulus_moments(&e, sigma)?))
                     })
-                    .collect::<Result<Vec<_>>>()
+                    .collect::<Result<Vec<_>>>();
+                let k = done.fetch_add(1, Ordering::Relaxed) + 1;
+                observer.steps_done(k, speeds_rpm.len());
+                row
             })
             .collect::<Result<Vec<_>>>()?;
         let (moments, modulus_moments) = rows.into_iter().map(|r| r.into_iter().unzip()).unzip();
@@ -238,7 +247,8 @@ fn first_crossing(depths: &[f64], g: &[f64]) -> Option<f64> {
 }
 
 /// [`MomentGrid`] for a machining model: Eq. 15-16 from the discretized transition matrix of
-/// `method` for the named `parameters`, then Eq. 17-18 with covariance `sigma`.
+/// `method` for the named `parameters`, then Eq. 17-18 with covariance `sigma`; `observer`
+/// hears of each speed done and can stop the grid between cells ([`MomentGrid::evaluate`]).
 pub fn model_moment_grid(
     method: chatter_stability::monodromy::Discretization,
     model: &chatter_dynamics::ModalModel,
@@ -246,21 +256,28 @@ pub fn model_moment_grid(
     sigma: &DMatrix<f64>,
     speeds_rpm: &[f64],
     depths_mm: &[f64],
+    observer: &dyn Observer,
 ) -> Result<MomentGrid> {
-    MomentGrid::evaluate(speeds_rpm, depths_mm, sigma, |speed, depth_mm| {
-        let s = chatter_stability::sensitivity::eigenvalue_sensitivity(
-            method,
-            model,
-            parameters,
-            speed,
-            depth_mm * 1e-3,
-        )?;
-        Ok(EigenSensitivity {
-            mu: s.mu,
-            gradient: s.gradient,
-            hessian: s.hessian,
-        })
-    })
+    MomentGrid::evaluate(
+        speeds_rpm,
+        depths_mm,
+        sigma,
+        |speed, depth_mm| {
+            let s = chatter_stability::sensitivity::eigenvalue_sensitivity(
+                method,
+                model,
+                parameters,
+                speed,
+                depth_mm * 1e-3,
+            )?;
+            Ok(EigenSensitivity {
+                mu: s.mu,
+                gradient: s.gradient,
+                hessian: s.hessian,
+            })
+        },
+        observer,
+    )
 }
 
 #[cfg(test)]
@@ -361,7 +378,9 @@ mod tests {
         let mut widths = Vec::new();
         for s2 in [0.001, 0.01] {
             let sigma = DMatrix::from_element(1, 1, s2);
-            let grid = MomentGrid::evaluate(&speeds, &depths, &sigma, sens).unwrap();
+            let grid =
+                MomentGrid::evaluate(&speeds, &depths, &sigma, sens, &chatter_progress::Silent)
+                    .unwrap();
             let p = grid.bounds(BoundRule::ComplexSd)[0];
             let (lo, mid, up) = (
                 p.lower_mm.unwrap(),

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::{Parameter, examples};
+use chatter_progress::Silent;
 use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::sensitivity::eigenvalue_sensitivity;
 use chatter_uncertainty::perturbation::{EigenSensitivity, model_moment_grid, moments};
@@ -34,7 +35,8 @@ fn moments_match_monte_carlo_and_widen() {
     let sigma = &eq34 * 0.1;
     let method = Discretization::full().with_steps(steps::<60>());
     let (rpm, mm) = (7150.0, 2.0);
-    let grid = model_moment_grid(method, &model, &params, &sigma, &[rpm], &[mm, 2.2]).unwrap();
+    let grid =
+        model_moment_grid(method, &model, &params, &sigma, &[rpm], &[mm, 2.2], &Silent).unwrap();
     let m = grid.moments[0][0];
     let chol = sigma.clone().cholesky().unwrap().l();
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
@@ -55,7 +57,8 @@ fn moments_match_monte_carlo_and_widen() {
     let sd = (samples.iter().map(|z| (z - mean).norm_sqr()).sum::<f64>() / 1999.0).sqrt();
     assert!((mean - m.mean).norm() < 1e-3, "mean {mean} vs {}", m.mean);
     assert!((sd - m.std()).abs() < 0.15 * sd, "sd {sd} vs {}", m.std());
-    let wide = model_moment_grid(method, &model, &params, &eq34, &[rpm], &[mm, 2.2]).unwrap();
+    let wide =
+        model_moment_grid(method, &model, &params, &eq34, &[rpm], &[mm, 2.2], &Silent).unwrap();
     assert!(wide.moments[0][0].std() > m.std());
 }
 
@@ -118,6 +121,7 @@ fn updated_bounds_cover_the_range_and_bracket_the_7300_rpm_cuts() {
         &eq34,
         &speeds,
         &depths,
+        &Silent,
     )
     .unwrap();
     for rule in [BoundRule::ComplexSd, BoundRule::coverage(0.95).unwrap()] {

@@ -129,18 +129,23 @@ def update(
     sampler: str = "itmcmc",
     samples: int = 5000,
     parameters: Optional[Sequence[str]] = None,
-    priors: Optional[dict] = None,
+    priors: Optional[Source] = None,
     classes: Optional[Sequence[float]] = None,
     surrogate: str = "gp",
     surrogate_points: int = 400,
     pointwise: bool = True,
+    method: Optional[str] = None,
 ) -> dict:
     """Bayesian updating (the ``chatter update`` job): ``parameter_names``, ``samples``
     (draws x parameters), ``weights``, ``posterior_mean``, ``posterior_covariance``,
     ``classes`` (``alpha``, ``log_evidence`` and ``data_fit`` in nats, ``probability``),
     ``selected_alpha``, ``prior_draws``, ``log_likelihood`` (draws x observations, nats),
     ``updated_model``, ``pole_table``, ``prior_bound_pileups``, ``surrogate``, ``warnings`` (the
-    sentences ``chatter update`` prints after ``warning:``)."""
+    sentences ``chatter update`` prints after ``warning:``). ``priors`` (a dict or a path, the
+    ``--priors`` file): marginals by name, or one correlated normal ``{"parameter_names",
+    "mean", "covariance"}`` such as 004's RCSA prior (``examples/schmitz2022_rcsa_prior.json``),
+    whose names are then the updated parameters unless ``parameters`` is given. ``method``: the
+    stability method of a cut likelihood, "fdm" (default), "sdm" or "zoa" (cut results only)."""
 
 def plan(
     model: Source,
@@ -148,7 +153,7 @@ def plan(
     strategy: str = "mrr",
     p_test: float = 0.5,
     parameters: Optional[Sequence[str]] = None,
-    priors: Optional[dict] = None,
+    priors: Optional[Source] = None,
     target: Optional[str] = None,
     paths: int = 300,
     speeds_rpm: Optional[Array] = None,
@@ -156,10 +161,12 @@ def plan(
     feed_per_tooth_mm: float = 0.1,
     seed: int = 0,
     max_tests: int = 10,
+    method: Optional[str] = None,
 ) -> dict:
     """The next test cut (the ``chatter plan`` JSON): ``next_cut`` (``speed_rpm``, ``depth_mm``,
     ``p_stable``, ...), ``stop``, ``posterior_mean``, ``posterior_sd``, ..., ``warnings`` (the
-    sentences ``chatter plan`` prints after ``warning:``)."""
+    sentences ``chatter plan`` prints after ``warning:``). ``priors`` as in :func:`update`;
+    ``method`` the stability method of the sampled boundaries ("fdm", "sdm" or "zoa")."""
 
 def diagnose(
     model: Source,
