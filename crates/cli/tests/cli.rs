@@ -771,7 +771,7 @@ fn plan_takes_the_004_correlated_prior() {
 
 /// `chatter update` on a few cuts with 004's correlated prior file and the zero-order cut
 /// likelihood: the eight prior names are the updated parameters, and the posterior keeps the
-/// modal block's correlation (corr(f_n1, k_1) = 0.999994 in the prior, where the cuts say
+/// modal block's correlation (corr(f_n1, k_1) = 0.9999977 in the prior, where the cuts say
 /// nothing); `--method` with identified poles is refused naming it.
 #[test]
 fn update_takes_the_004_correlated_prior() {
@@ -813,10 +813,20 @@ fn update_takes_the_004_correlated_prior() {
     assert_eq!(names.len(), 8);
     assert_eq!(names[2], "fn1_hz");
     assert_eq!(names[3], "k1_n_per_m");
-    let c = |i: usize, j: usize| summary["posterior_covariance"][i][j].as_f64().unwrap();
-    let r = c(2, 3) / (c(2, 2) * c(3, 3)).sqrt();
-    // Fisher z of 0.999994 is 6.06; 300 samples (effective 100 or more) put it within 0.4
-    assert!((r.atanh() - 0.999994f64.atanh()).abs() < 0.4, "{r}");
+    let correlation = |cov: &serde_json::Value| {
+        let c = |i: usize, j: usize| cov[i][j].as_f64().unwrap();
+        c(2, 3) / (c(2, 2) * c(3, 3)).sqrt()
+    };
+    let r = correlation(&summary["posterior_covariance"]);
+    let prior: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&priors).unwrap()).unwrap();
+    let r_prior = correlation(&prior["covariance"]);
+    // Fisher z of the prior's 0.9999977 is 6.84; 300 samples (effective 100 or more) put the
+    // posterior's within 0.4 (measured 6.857)
+    assert!(
+        (r.atanh() - r_prior.atanh()).abs() < 0.4,
+        "{r} vs {r_prior}"
+    );
     let err = fail(&mut update(
         &["--method", "zoa", "--seed", "1"],
         example("ahmadi2022_turning_model.json"),
