@@ -7,7 +7,8 @@ use chatter_dynamics::examples;
 use chatter_progress::Silent;
 use chatter_uncertainty::geometric::{OffsetBoundaries, schmitz2023};
 use chatter_uncertainty::sensitivity::{
-    TABLE3_STEPS_PER_REVOLUTION, TransitionMap, pole_sensitivity,
+    TABLE3_MODE2, TABLE3_MODE2_PARAMETERS, TABLE3_STEPS_PER_REVOLUTION, TransitionMap,
+    pole_sensitivity,
 };
 use chatter_updating::{ebrahimi2025, karandikar, schmitz2022};
 use std::fmt::Write as _;
@@ -40,20 +41,13 @@ impl Row {
 /// mode 2 at P1-P5; tolerance 3 % of the paper's value.
 fn ahmadi_table_3() -> Result<Vec<Row>> {
     let model = examples::ahmadi_2022_turning();
-    let names = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
+    let names = TABLE3_MODE2_PARAMETERS;
     let params = names
         .iter()
         .map(|s| s.parse())
         .collect::<Result<Vec<_>, _>>()?;
-    let table = [
-        ("P1", 7150.0, 2.286, [0.3105, 0.0028, 0.0078]),
-        ("P2", 7150.0, 2.54, [0.3025, 0.0028, 0.0080]),
-        ("P3", 6950.0, 2.54, [0.2753, 0.0025, 0.0122]),
-        ("P4", 7500.0, 2.032, [0.3126, 0.0028, 0.0071]),
-        ("P5", 7500.0, 2.54, [0.2955, 0.0027, 0.0075]),
-    ];
     let mut rows = Vec::new();
-    for (point, rpm, mm, paper) in table {
+    for (point, rpm, mm, paper) in TABLE3_MODE2 {
         let s = pole_sensitivity(
             &model,
             &params,

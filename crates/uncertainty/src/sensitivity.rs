@@ -31,6 +31,19 @@ use std::num::NonZeroUsize;
 /// Steps per revolution of the sensitivities of 000 Table 3.
 pub const TABLE3_STEPS_PER_REVOLUTION: NonZeroUsize = steps::<200>();
 
+/// The parameters of 000 Table 3's mode-2 columns, in [`TABLE3_MODE2`]'s order.
+pub const TABLE3_MODE2_PARAMETERS: [&str; 3] = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
+
+/// 000 Table 3's mode-2 rows as printed (2-4 significant digits): the point, its speed (rpm)
+/// and depth (mm), and |d mu / d theta| for [`TABLE3_MODE2_PARAMETERS`].
+pub const TABLE3_MODE2: [(&str, f64, f64, [f64; 3]); 5] = [
+    ("P1", 7150.0, 2.286, [0.3105, 0.0028, 0.0078]),
+    ("P2", 7150.0, 2.54, [0.3025, 0.0028, 0.0080]),
+    ("P3", 6950.0, 2.54, [0.2753, 0.0025, 0.0122]),
+    ("P4", 7500.0, 2.032, [0.3126, 0.0028, 0.0071]),
+    ("P5", 7500.0, 2.54, [0.2955, 0.0027, 0.0075]),
+];
+
 /// Which map's dominant eigenvalue is differentiated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -150,18 +163,11 @@ mod tests {
     #[test]
     fn table3_mode2_rows() {
         let model = examples::ahmadi_2022_turning();
-        let params: Vec<Parameter> = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"]
+        let params: Vec<Parameter> = TABLE3_MODE2_PARAMETERS
             .iter()
             .map(|s| s.parse().unwrap())
             .collect();
-        let table3 = [
-            (7150.0, 2.286, [0.3105, 0.0028, 0.0078]),
-            (7150.0, 2.54, [0.3025, 0.0028, 0.0080]),
-            (6950.0, 2.54, [0.2753, 0.0025, 0.0122]),
-            (7500.0, 2.032, [0.3126, 0.0028, 0.0071]),
-            (7500.0, 2.54, [0.2955, 0.0027, 0.0075]),
-        ];
-        for (rpm, mm, paper) in table3 {
+        for (_, rpm, mm, paper) in TABLE3_MODE2 {
             let one = pole_sensitivity(
                 &model,
                 &params,
