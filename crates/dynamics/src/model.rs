@@ -361,8 +361,15 @@ impl ModalModel {
     /// The same model with residual terms per coordinate (module docs); finite values.
     pub fn with_residuals(&self, residuals: [ResidualTerms; 2]) -> Result<Self> {
         for (i, r) in residuals.iter().enumerate() {
-            finite(&format!("residuals[{i}].upper_m_per_n"), r.upper_m_per_n)?;
-            finite(&format!("residuals[{i}].lower_per_kg"), r.lower_per_kg)?;
+            for (term, v) in [
+                ("upper_m_per_n", r.upper_m_per_n),
+                ("lower_per_kg", r.lower_per_kg),
+            ] {
+                // the field's name is written only for the error (samplers rebuild models often)
+                if !v.is_finite() {
+                    finite(&format!("residuals[{i}].{term}"), v)?;
+                }
+            }
         }
         Ok(Self {
             residuals,
@@ -398,14 +405,7 @@ impl ModalModel {
 
     /// The same model with another operation (e.g. a per-cut radial immersion).
     pub fn with_operation(&self, operation: Operation) -> Result<Self> {
-        Self::new(
-            self.name.clone(),
-            operation,
-            self.cutting,
-            self.modes.clone(),
-            self.process_damping_n_per_m,
-        )?
-        .with_residuals(self.residuals)
+        self.rebuilt(operation, self.modes.clone(), self.process_damping_n_per_m)
     }
     /// The same model with other cutting coefficients.
     pub fn with_cutting(&self, cutting: CuttingCoefficients) -> Self {
@@ -416,25 +416,31 @@ impl ModalModel {
     }
     /// The same model with other modes (at least one).
     pub fn with_modes(&self, modes: Vec<Mode>) -> Result<Self> {
-        Self::new(
-            self.name.clone(),
-            self.operation.clone(),
-            self.cutting,
-            modes,
-            self.process_damping_n_per_m,
-        )?
-        .with_residuals(self.residuals)
+        self.rebuilt(self.operation.clone(), modes, self.process_damping_n_per_m)
     }
     /// The same model with another process-damping coefficient.
     pub fn with_process_damping(&self, c_n_per_m: Option<f64>) -> Result<Self> {
-        Self::new(
+        self.rebuilt(self.operation.clone(), self.modes.clone(), c_n_per_m)
+    }
+    /// The model [`ModalModel::new`] checks with this one's name, cutting coefficients and
+    /// residual terms (checked when they were set).
+    fn rebuilt(
+        &self,
+        operation: Operation,
+        modes: Vec<Mode>,
+        process_damping_n_per_m: Option<f64>,
+    ) -> Result<Self> {
+        let model = Self::new(
             self.name.clone(),
-            self.operation.clone(),
+            operation,
             self.cutting,
-            self.modes.clone(),
-            c_n_per_m,
-        )?
-        .with_residuals(self.residuals)
+            modes,
+            process_damping_n_per_m,
+        )?;
+        Ok(Self {
+            residuals: self.residuals,
+            ..model
+        })
     }
     /// The same model renamed.
     pub fn with_name(&self, name: Option<String>) -> Self {

@@ -211,17 +211,24 @@ impl OrientedSystem {
         for (n, m) in self.modes.iter().enumerate() {
             let zeta = added.damping_ratio(n, m)?;
             let wn = m.omega_rad_s;
+            // 1 / (w_n^2 - w^2 + 2 i zeta w_n w) with one division (the tables' hot loop)
+            let (re, im) = (wn * wn - w * w, 2.0 * zeta * wn * w);
+            let scale = 1.0 / (re * re + im * im);
+            let mut inv = Complex64::new(re * scale, -im * scale);
             let (n0, n1) = m.numerator;
-            let inv =
-                Complex64::new(n0, n1 * w) / Complex64::new(wn * wn - w * w, 2.0 * zeta * wn * w);
+            if (n0, n1) != (1.0, 0.0) {
+                inv *= Complex64::new(n0, n1 * w);
+            }
             let [p, q] = m.shape;
             g[0] += inv * (p * p);
             g[1] += inv * (p * q);
             g[2] += inv * (q * q);
         }
-        let hz = w / (2.0 * PI);
-        g[0] += self.residuals[0].receptance(hz);
-        g[2] += self.residuals[1].receptance(hz);
+        if !(self.residuals[0].is_zero() && self.residuals[1].is_zero()) {
+            let hz = w / (2.0 * PI);
+            g[0] += self.residuals[0].receptance(hz);
+            g[2] += self.residuals[1].receptance(hz);
+        }
         let a = &self.directional_n_per_m2;
         let m00 = g[0] * a[0][0] + g[1] * a[0][1];
         let m01 = g[1] * a[0][0] + g[2] * a[0][1];
@@ -250,6 +257,9 @@ impl OrientedSystem {
     /// the condition reads (phi^T A_0 phi) sin(w_n tau) < 0: half of every lobe interval, the
     /// limit of the lobes' flat bottoms, b_min = 2 zeta (1 + zeta) k / K, as zeta -> 0.
     pub(crate) fn zero_depth_lobe(&self, delay_s: f64, slopes_per_m: &[f64]) -> Option<Lobe> {
+        if self.modes.iter().all(|m| m.damping_ratio != 0.0) {
+            return None; // every query's common case, without allocating
+        }
         let undamped: Vec<usize> = (0..self.modes.len())
             .filter(|&n| self.modes[n].damping_ratio == 0.0)
             .collect();
