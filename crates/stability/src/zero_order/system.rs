@@ -44,6 +44,9 @@ pub struct OrientedSystem {
     directional_n_per_m2: [[f64; 2]; 2],
     /// Residual terms of the direct receptances (`chatter_dynamics::ResidualTerms`).
     residuals: [ResidualTerms; 2],
+    /// Whether a mode is non-proportional or a residual term is set: the general receptance
+    /// (the tables' hot loop skips both otherwise).
+    general: bool,
 }
 
 /// Process damping folded into the modal damping ratios at one depth: zeta_n + b s_n.
@@ -162,10 +165,12 @@ impl OrientedSystem {
         {
             return invalid("directional_n_per_m2", v, "a finite directional matrix");
         }
+        let general = modes.iter().any(|m| m.numerator != (1.0, 0.0));
         Ok(Self {
             modes,
             directional_n_per_m2,
             residuals: [ResidualTerms::default(); 2],
+            general,
         })
     }
 
@@ -184,6 +189,7 @@ impl OrientedSystem {
             .collect();
         let mut system = Self::new(modes, [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]])?;
         system.residuals = model.residuals();
+        system.general |= system.residuals.iter().any(|r| !r.is_zero());
         Ok(system)
     }
 
@@ -215,16 +221,15 @@ impl OrientedSystem {
             let (re, im) = (wn * wn - w * w, 2.0 * zeta * wn * w);
             let scale = 1.0 / (re * re + im * im);
             let mut inv = Complex64::new(re * scale, -im * scale);
-            let (n0, n1) = m.numerator;
-            if (n0, n1) != (1.0, 0.0) {
-                inv *= Complex64::new(n0, n1 * w);
+            if self.general {
+                inv *= Complex64::new(m.numerator.0, m.numerator.1 * w);
             }
             let [p, q] = m.shape;
             g[0] += inv * (p * p);
             g[1] += inv * (p * q);
             g[2] += inv * (q * q);
         }
-        if !(self.residuals[0].is_zero() && self.residuals[1].is_zero()) {
+        if self.general {
             let hz = w / (2.0 * PI);
             g[0] += self.residuals[0].receptance(hz);
             g[2] += self.residuals[1].receptance(hz);
