@@ -350,29 +350,37 @@ impl<P: Prior, L: LogLikelihood> Chains<'_, P, L> {
         let mut rng = stream(self.seed, self.stage, chain);
         let mut px = self.prior.ln_pdf(&x);
         let mut accepted = 0;
+        // buffers reused by every move, and the evaluations counted here and added once: the
+        // shared counter's cache line is not passed between the threads at every move
+        let (mut z, mut step, mut y) = (DVector::zeros(d), DVector::zeros(d), vec![0.0; d]);
+        let mut evaluations = 0;
         for _ in 0..self.steps {
             if self.observer.cancelled() {
                 break;
             }
-            let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
-            let step = self.factor * z * self.scale;
-            let y: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+            z.iter_mut()
+                .for_each(|zi| *zi = StandardNormal.sample(&mut rng));
+            self.factor.mul_to(&z, &mut step);
+            for ((yi, xi), si) in y.iter_mut().zip(&x).zip(step.iter()) {
+                *yi = xi + si * self.scale;
+            }
             let py = self.prior.ln_pdf(&y);
             if !py.is_finite() {
                 continue;
             }
-            self.evaluations
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            evaluations += 1;
             let ly = counted_ln_likelihood(self.likelihood, &y, self.failures);
             let log_ratio = py + self.beta * ly - px - self.beta * lx;
             let u: f64 = rand::Rng::random::<f64>(&mut rng);
             if log_ratio >= 0.0 || u.ln() < log_ratio {
-                x = y;
+                std::mem::swap(&mut x, &mut y);
                 lx = ly;
                 px = py;
                 accepted += 1;
             }
         }
+        self.evaluations
+            .fetch_add(evaluations, std::sync::atomic::Ordering::Relaxed);
         (x, lx, accepted)
     }
 }
