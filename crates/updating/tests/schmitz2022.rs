@@ -318,7 +318,9 @@ fn sec6_replayed_sequences_stop_by_the_rules_and_match_the_paper() {
             .filter(|t| t.stable)
             .filter_map(|t| t.plan.mrr_cm3_per_min)
             .fold(f64::NAN, f64::max);
-        assert_eq!(best, Some(stable_best));
+        // (the observation holds the cut's depth in mm, the plan in m: equal to rounding)
+        let best = best.unwrap_or(f64::NAN);
+        assert!((best - stable_best).abs() <= 1e-12 * stable_best, "{best} vs {stable_best}");
         // an unstable test carries a chatter frequency, a stable one none
         assert!(r.tests.iter().all(|t| t.stable == t.chatter_hz.is_none()));
     }
