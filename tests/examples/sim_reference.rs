@@ -116,16 +116,19 @@ fn chatter(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64, fs: f64, dur
     );
 }
 
-fn noisy(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64) {
-    let s = SimulationSettings::new(rpm, depth_mm * 1e-3, 1.0, 50_000.0, 1);
+fn noisy(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64, random: f64, quantity: Quantity) {
+    let mut s = SimulationSettings::new(rpm, depth_mm * 1e-3, 1.0, 50_000.0, 1);
+    s.random_force_rms_n = random;
+    s.quantity = quantity;
     let t0 = Instant::now();
     let sim = simulate(model, &s).unwrap();
     let el = t0.elapsed().as_secs_f64();
     let x = &sim.channels[0].data;
+    let scale = if quantity == Quantity::Displacement { 1e6 } else { 1.0 };
     println!(
-        "{name:28} rms(acc x) {:.5e} rms(acc y) {:.5e}  lost {:.5}  ({el:.3} s)",
-        rms(&x[x.len() / 5..]),
-        rms(&sim.channels[1].data[x.len() / 5..]),
+        "{name:28} rms x {:.5e} rms y {:.5e}  lost {:.5}  ({el:.3} s)",
+        rms(&x[x.len() / 5..]) * scale,
+        rms(&sim.channels[1].data[x.len() / 5..]) * scale,
         sim.lost_contact_fraction
     );
 }
@@ -141,6 +144,8 @@ fn main() {
     stable("000 7150 rpm 2.0 mm", &m000, 7150.0, 2.0, 40, (3, 60));
     chatter("001 7000 rpm 2.0 mm chatter", &m001, 7000.0, 2.0, 20_000.0, 1.0);
     chatter("000 7150 rpm 5.0 mm chatter", &m000, 7150.0, 5.0, 20_000.0, 1.0);
-    noisy("bench 001 7000 rpm 0.5 mm", &m001, 7000.0, 0.5);
-    noisy("bench 000 7150 rpm 2 mm", &m000, 7150.0, 2.0);
+    noisy("bench 001 7000 rpm 0.5 mm", &m001, 7000.0, 0.5, 1.0, Quantity::Acceleration);
+    noisy("bench 000 7150 rpm 2 mm", &m000, 7150.0, 2.0, 1.0, Quantity::Acceleration);
+    noisy("001 0.5 mm acc no random", &m001, 7000.0, 0.5, 0.0, Quantity::Acceleration);
+    noisy("001 0.5 mm disp (x1e6)", &m001, 7000.0, 0.5, 1.0, Quantity::Displacement);
 }

@@ -10,7 +10,6 @@
 //! 0.49 f_eff, which would fold into the band, is removed, and the band up to about 0.3 f_eff is
 //! passed with a gain within 1e-3 of one.
 
-use std::collections::VecDeque;
 use std::f64::consts::PI;
 
 /// Cutoff of the low-pass as a fraction of the effective rate (half-amplitude point).
@@ -27,9 +26,14 @@ pub(crate) struct Resampler<const N: usize> {
     input_step_s: f64,
     output_rate_hz: f64,
     half_width_s: f64,
-    table: Vec<f64>,
-    /// Input samples kept, the first being input index `first`.
-    buffer: VecDeque<[f64; N]>,
+    /// The kernel over [-W, W] at 2 [`TABLE_POINTS`] + 1 points, each with the difference to
+    /// the next (zero past the end), so one load gives both ends of the interpolation.
+    table: Vec<[f64; 2]>,
+    /// Table points per second of kernel argument.
+    table_scale: f64,
+    /// Input samples kept, the first being input index `first`; the consumed front is dropped
+    /// in blocks (a contiguous slice per output).
+    buffer: Vec<[f64; N]>,
     first: usize,
     /// Input samples pushed so far.
     pushed: usize,
@@ -43,27 +47,37 @@ impl<const N: usize> Resampler<N> {
         let f_eff = output_rate_hz.min(1.0 / input_step_s);
         let fc = CUTOFF_FRACTION * f_eff;
         let half_width_s = HALF_WIDTH_PERIODS / f_eff;
-        let table = (0..=TABLE_POINTS)
-            .map(|i| {
-                let t = half_width_s * i as f64 / TABLE_POINTS as f64;
-                let x = 2.0 * fc * t;
-                let sinc = if x == 0.0 {
-                    1.0
-                } else {
-                    (PI * x).sin() / (PI * x)
-                };
-                // Blackman window over [-W, W], evaluated at t >= 0
-                let u = PI * (t / half_width_s + 1.0);
-                let w = 0.42 - 0.5 * u.cos() + 0.08 * (2.0 * u).cos();
-                sinc * w
-            })
+        let kernel = |i: usize| {
+            let t = half_width_s * i as f64 / TABLE_POINTS as f64;
+            let x = 2.0 * fc * t;
+            let sinc = if x == 0.0 {
+                1.0
+            } else {
+                (PI * x).sin() / (PI * x)
+            };
+            // Blackman window over [-W, W], evaluated at t >= 0
+            let u = PI * (t / half_width_s + 1.0);
+            let w = 0.42 - 0.5 * u.cos() + 0.08 * (2.0 * u).cos();
+            sinc * w
+        };
+        let half: Vec<f64> = (0..=TABLE_POINTS).map(kernel).collect();
+        // symmetric table over [-W, W]: point i at t = (i - TABLE_POINTS) W / TABLE_POINTS
+        let values: Vec<f64> = (0..=2 * TABLE_POINTS)
+            .map(|i| half[i.abs_diff(TABLE_POINTS)])
+            .chain([0.0])
+            .collect();
+        let table = values
+            .windows(2)
+            .map(|w| [w[0], w[1] - w[0]])
+            .chain([[0.0, 0.0]])
             .collect();
         Self {
             input_step_s,
             output_rate_hz,
             half_width_s,
             table,
-            buffer: VecDeque::new(),
+            table_scale: TABLE_POINTS as f64 / half_width_s,
+            buffer: Vec::new(),
             first: 0,
             pushed: 0,
             next: 0,
@@ -75,23 +89,14 @@ impl<const N: usize> Resampler<N> {
         self.half_width_s
     }
 
-    fn kernel(&self, t: f64) -> f64 {
-        let x = t.abs() / self.half_width_s * TABLE_POINTS as f64;
-        let i = x.floor() as usize;
-        if i >= TABLE_POINTS {
-            return 0.0;
-        }
-        let frac = x - i as f64;
-        self.table[i] + frac * (self.table[i + 1] - self.table[i])
-    }
-
     /// Add the next input sample and write every output that is now complete into `out` (one
     /// slice per channel) up to its length.
     pub(crate) fn push(&mut self, value: [f64; N], out: &mut [Vec<f64>; N]) {
-        self.buffer.push_back(value);
+        self.buffer.push(value);
         self.pushed += 1;
         let n_out = out[0].len();
         let last_time = (self.pushed - 1) as f64 * self.input_step_s;
+        let last_point = self.table.len() - 1;
         while self.next < n_out {
             let ts = self.next as f64 / self.output_rate_hz;
             if ts + self.half_width_s > last_time {
@@ -101,25 +106,36 @@ impl<const N: usize> Resampler<N> {
                 .ceil()
                 .max(0.0) as usize;
             let hi = ((ts + self.half_width_s) / self.input_step_s).floor() as usize;
+            let (lo, hi) = (lo.max(self.first), hi.min(self.pushed - 1));
+            // table position of input lo, advancing by a constant per input
+            let mut x = (lo as f64 * self.input_step_s - ts + self.half_width_s) * self.table_scale;
+            let dx = self.input_step_s * self.table_scale;
             let (mut acc, mut weight) = ([0.0; N], 0.0);
-            for k in lo.max(self.first)..=hi.min(self.pushed - 1) {
-                let g = self.kernel(ts - k as f64 * self.input_step_s);
-                let v = &self.buffer[k - self.first];
-                for c in 0..N {
-                    acc[c] += g * v[c];
+            if lo <= hi {
+                for v in &self.buffer[lo - self.first..=hi - self.first] {
+                    // x >= 0 up to rounding (a negative x saturates to point 0)
+                    let i = (x as usize).min(last_point);
+                    let [g0, dg] = self.table[i];
+                    let g = g0 + (x - i as f64) * dg;
+                    for c in 0..N {
+                        acc[c] += g * v[c];
+                    }
+                    weight += g;
+                    x += dx;
                 }
-                weight += g;
             }
             for c in 0..N {
                 out[c][self.next] = if weight != 0.0 { acc[c] / weight } else { 0.0 };
             }
             self.next += 1;
-            // drop inputs no later output needs
+            // drop inputs no later output needs, in blocks
             let t_next = self.next as f64 / self.output_rate_hz - self.half_width_s;
-            let keep_from = (t_next / self.input_step_s).ceil().max(0.0) as usize;
-            while self.first < keep_from && !self.buffer.is_empty() {
-                self.buffer.pop_front();
-                self.first += 1;
+            let keep_from = ((t_next / self.input_step_s).ceil().max(0.0) as usize)
+                .clamp(self.first, self.pushed);
+            let drop = keep_from - self.first;
+            if drop >= 1024 && 2 * drop >= self.buffer.len() {
+                self.buffer.drain(..drop);
+                self.first = keep_from;
             }
         }
     }
