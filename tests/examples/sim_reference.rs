@@ -5,7 +5,9 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::ModalModel;
-use chatter_dynamics::examples::{ahmadi_2022_turning, ebrahimi_2025_milling, schmitz_2023_milling};
+use chatter_dynamics::examples::{
+    ahmadi_2022_turning, ebrahimi_2025_milling, schmitz_2023_milling,
+};
 use chatter_dynamics::simulate::{Quantity, SimulationSettings, simulate};
 use chatter_stability::monodromy::Discretization;
 use rustfft::FftPlanner;
@@ -37,7 +39,14 @@ fn fit_multiplier(seqs: &[Vec<f64>]) -> Complex64 {
     if z.im < 0.0 { z.conj() } else { z }
 }
 
-fn stable(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64, per_delay: usize, k: (usize, usize)) {
+fn stable(
+    name: &str,
+    model: &ModalModel,
+    rpm: f64,
+    depth_mm: f64,
+    per_delay: usize,
+    k: (usize, usize),
+) {
     let tau = model.operation().delay_s(rpm);
     let fs = per_delay as f64 / tau;
     let dur = (k.1 + 3) as f64 * tau;
@@ -58,7 +67,11 @@ fn stable(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64, per_delay: us
         .unwrap()
         .dominant_eigenvalue()
         .unwrap();
-    let reference = if reference.im < 0.0 { reference.conj() } else { reference };
+    let reference = if reference.im < 0.0 {
+        reference.conj()
+    } else {
+        reference
+    };
     println!(
         "{name:28} simulated mu |{:.5}| arg {:.5}   monodromy |{:.5}| arg {:.5}   d|mu| {:+.5}  lost {:.5}  ({el:.2} s)",
         mu.norm(),
@@ -124,7 +137,11 @@ fn noisy(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64, random: f64, q
     let sim = simulate(model, &s).unwrap();
     let el = t0.elapsed().as_secs_f64();
     let x = &sim.channels[0].data;
-    let scale = if quantity == Quantity::Displacement { 1e6 } else { 1.0 };
+    let scale = if quantity == Quantity::Displacement {
+        1e6
+    } else {
+        1.0
+    };
     println!(
         "{name:28} rms x {:.5e} rms y {:.5e}  lost {:.5}  ({el:.3} s)",
         rms(&x[x.len() / 5..]) * scale,
@@ -142,10 +159,52 @@ fn main() {
     stable("001 7000 rpm 0.5 mm", &m001, 7000.0, 0.5, 20, (3, 60));
     stable("001 7000 rpm 1.0 mm", &m001, 7000.0, 1.0, 20, (3, 60));
     stable("000 7150 rpm 2.0 mm", &m000, 7150.0, 2.0, 40, (3, 60));
-    chatter("001 7000 rpm 2.0 mm chatter", &m001, 7000.0, 2.0, 20_000.0, 1.0);
-    chatter("000 7150 rpm 5.0 mm chatter", &m000, 7150.0, 5.0, 20_000.0, 1.0);
-    noisy("bench 001 7000 rpm 0.5 mm", &m001, 7000.0, 0.5, 1.0, Quantity::Acceleration);
-    noisy("bench 000 7150 rpm 2 mm", &m000, 7150.0, 2.0, 1.0, Quantity::Acceleration);
-    noisy("001 0.5 mm acc no random", &m001, 7000.0, 0.5, 0.0, Quantity::Acceleration);
-    noisy("001 0.5 mm disp (x1e6)", &m001, 7000.0, 0.5, 1.0, Quantity::Displacement);
+    chatter(
+        "001 7000 rpm 2.0 mm chatter",
+        &m001,
+        7000.0,
+        2.0,
+        20_000.0,
+        1.0,
+    );
+    chatter(
+        "000 7150 rpm 5.0 mm chatter",
+        &m000,
+        7150.0,
+        5.0,
+        20_000.0,
+        1.0,
+    );
+    noisy(
+        "bench 001 7000 rpm 0.5 mm",
+        &m001,
+        7000.0,
+        0.5,
+        1.0,
+        Quantity::Acceleration,
+    );
+    noisy(
+        "bench 000 7150 rpm 2 mm",
+        &m000,
+        7150.0,
+        2.0,
+        1.0,
+        Quantity::Acceleration,
+    );
+    noisy(
+        "001 0.5 mm acc no random",
+        &m001,
+        7000.0,
+        0.5,
+        0.0,
+        Quantity::Acceleration,
+    );
+    noisy(
+        "001 0.5 mm disp (x1e6)",
+        &m001,
+        7000.0,
+        0.5,
+        1.0,
+        Quantity::Displacement,
+    );
 }
