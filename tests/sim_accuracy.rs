@@ -51,7 +51,13 @@ fn slotting_multiplier_from_the_transient() {
     s.quantity = Quantity::Displacement;
     s.random_force_rms_n = 0.0;
     let sim = simulate(&model, &s).unwrap();
-    assert_eq!(sim.lost_contact_fraction, 0.0);
+    // contact is lost only at the zero-thickness entry and exit of the slot, for a vanishing
+    // part of the engaged time (8e-8)
+    assert!(
+        sim.lost_contact_fraction < 1e-5,
+        "{}",
+        sim.lost_contact_fraction
+    );
     let x: Vec<f64> = (8..90)
         .map(|k| sim.channels[0].data[k * per_tooth])
         .collect();
