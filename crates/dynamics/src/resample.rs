@@ -142,11 +142,22 @@ impl<const N: usize> Resampler<N> {
 
     /// Add the next input sample and write every output that is now complete into `out` (one
     /// slice per channel) up to its length.
+    #[inline]
     pub(crate) fn push(&mut self, value: [f64; N], out: &mut [Vec<f64>; N]) {
         self.buffer.push(value);
         self.pushed += 1;
-        let n_out = out[0].len();
+        // most inputs complete no output: test that before the call
         let last_time = (self.pushed - 1) as f64 * self.input_step_s;
+        if self.next < out[0].len()
+            && self.next as f64 / self.output_rate_hz + self.half_width_s <= last_time
+        {
+            self.write_outputs(last_time, out);
+        }
+    }
+
+    /// Write every output complete once the input reaches `last_time`.
+    fn write_outputs(&mut self, last_time: f64, out: &mut [Vec<f64>; N]) {
+        let n_out = out[0].len();
         let last_point = self.table.len() - 1;
         while self.next < n_out {
             let ts = self.next as f64 / self.output_rate_hz;
