@@ -1,7 +1,9 @@
 //! Reference figures of the time-domain simulator (deterministic cuts: no random force):
 //! the dominant Floquet multiplier of stable cuts measured from the start-up transient against
 //! the full discretization, and the limit cycle of chattering cuts (RMS, dominant tone, lost
-//! contact).
+//! contact). The 001 cuts lose contact near the zero-thickness exit, so their fitted multiplier
+//! is a figure to compare between steps, not with the full discretization. Run with a temporary
+//! `MIN_STEPS_PER_TOOTH` (e.g. 8000) for the converged figures.
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::ModalModel;
@@ -158,7 +160,6 @@ fn main() {
     stable("002 2500 rpm 0.5 mm", &m002, 2500.0, 0.5, 50, (8, 90));
     stable("001 7000 rpm 0.5 mm", &m001, 7000.0, 0.5, 20, (3, 60));
     stable("001 7000 rpm 1.0 mm", &m001, 7000.0, 1.0, 20, (3, 60));
-    stable("000 7150 rpm 2.0 mm", &m000, 7150.0, 2.0, 40, (3, 60));
     chatter(
         "001 7000 rpm 2.0 mm chatter",
         &m001,
