@@ -16,30 +16,11 @@
 #![allow(clippy::unwrap_used)]
 
 use chatter_dynamics::examples::{ebrahimi_2025_milling, schmitz_2023_milling};
-use chatter_dynamics::simulate::{Quantity, SimulationSettings, simulate};
+use chatter_dynamics::simulate::simulate;
 use chatter_stability::monodromy::Discretization;
-use rustfft::FftPlanner;
-use rustfft::num_complex::Complex64;
 
-/// Dominant multiplier from samples taken once per delay (least squares on the differences).
-fn fit_multiplier(s: &[f64]) -> Complex64 {
-    let d: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
-    let (mut s11, mut s12, mut s22, mut r1, mut r2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for w in d.windows(3) {
-        let (x1, x2, y) = (w[1], w[0], w[2]);
-        s11 += x1 * x1;
-        s12 += x1 * x2;
-        s22 += x2 * x2;
-        r1 += x1 * y;
-        r2 += x2 * y;
-    }
-    let det = s11 * s22 - s12 * s12;
-    let a = (r1 * s22 - r2 * s12) / det;
-    let b = (s11 * r2 - s12 * r1) / det;
-    let disc = Complex64::new(a * a + 4.0 * b, 0.0).sqrt();
-    let z = (Complex64::new(a, 0.0) + disc) / 2.0;
-    if z.im < 0.0 { z.conj() } else { z }
-}
+mod transient;
+use transient::{deterministic, fit_multiplier, peak, rms, upper};
 
 #[test]
 fn slotting_multiplier_from_the_transient() {
@@ -47,9 +28,7 @@ fn slotting_multiplier_from_the_transient() {
     let (rpm, depth) = (2500.0, 1.0e-3);
     let tau = model.operation().delay_s(rpm);
     let per_tooth = 50;
-    let mut s = SimulationSettings::new(rpm, depth, 93.0 * tau, per_tooth as f64 / tau, 1);
-    s.quantity = Quantity::Displacement;
-    s.random_force_rms_n = 0.0;
+    let s = deterministic(rpm, depth, 93.0 * tau, per_tooth as f64 / tau);
     let sim = simulate(&model, &s).unwrap();
     // contact is lost only at the zero-thickness entry and exit of the slot, for a vanishing
     // part of the engaged time (8e-8)
@@ -61,17 +40,14 @@ fn slotting_multiplier_from_the_transient() {
     let x: Vec<f64> = (8..90)
         .map(|k| sim.channels[0].data[k * per_tooth])
         .collect();
-    let mu = fit_multiplier(&x);
-    let reference = Discretization::full()
-        .monodromy(&model, rpm, depth)
-        .unwrap()
-        .dominant_eigenvalue()
-        .unwrap();
-    let reference = if reference.im < 0.0 {
-        reference.conj()
-    } else {
-        reference
-    };
+    let mu = fit_multiplier(&[x]);
+    let reference = upper(
+        Discretization::full()
+            .monodromy(&model, rpm, depth)
+            .unwrap()
+            .dominant_eigenvalue()
+            .unwrap(),
+    );
     eprintln!(
         "simulated |mu| {:.5} arg {:.5}; full discretization |mu| {:.5} arg {:.5}",
         mu.norm(),
@@ -93,31 +69,12 @@ fn slotting_multiplier_from_the_transient() {
 fn chatter_limit_cycle_matches_the_converged_step() {
     let model = schmitz_2023_milling();
     let fs = 20_000.0;
-    let mut s = SimulationSettings::new(7000.0, 2.0e-3, 1.0, fs, 1);
-    s.quantity = Quantity::Displacement;
-    s.random_force_rms_n = 0.0;
-    let sim = simulate(&model, &s).unwrap();
+    let sim = simulate(&model, &deterministic(7000.0, 2.0e-3, 1.0, fs)).unwrap();
     let x = &sim.channels[0].data;
     let tail = &x[x.len() / 2..];
-    let rms = (tail.iter().map(|v| v * v).sum::<f64>() / tail.len() as f64).sqrt();
+    let rms = rms(tail);
     // dominant tone: Hann-windowed spectrum, parabolic interpolation of the log magnitude
-    let n = tail.len();
-    let mean = tail.iter().sum::<f64>() / n as f64;
-    let mut buf: Vec<Complex64> = tail
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
-            Complex64::new((v - mean) * w, 0.0)
-        })
-        .collect();
-    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
-    let mag: Vec<f64> = buf[..n / 2].iter().map(|c| c.norm()).collect();
-    let i = (2..n / 2 - 1)
-        .max_by(|&a, &b| mag[a].total_cmp(&mag[b]))
-        .unwrap();
-    let (a, b, c) = (mag[i - 1].ln(), mag[i].ln(), mag[i + 1].ln());
-    let peak_hz = (i as f64 + 0.5 * (a - c) / (a - 2.0 * b + c)) * fs / n as f64;
+    let (peak_hz, _) = peak(tail, fs);
     eprintln!(
         "rms {rms:.5e} (converged 2.35172e-5), tone {peak_hz:.2} Hz, lost contact {:.4}",
         sim.lost_contact_fraction

@@ -12,34 +12,11 @@ use chatter_dynamics::examples::{
 };
 use chatter_dynamics::simulate::{Quantity, SimulationSettings, simulate};
 use chatter_stability::monodromy::Discretization;
-use rustfft::FftPlanner;
-use rustfft::num_complex::Complex64;
 use std::time::Instant;
 
-/// Multiplier from samples taken once per delay: d_k = s_{k+1} - s_k obeys
-/// d_{k+2} = a d_{k+1} + b d_k for the dominant pair; least squares over every channel.
-fn fit_multiplier(seqs: &[Vec<f64>]) -> Complex64 {
-    let (mut s11, mut s12, mut s22, mut r1, mut r2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for s in seqs {
-        let d: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
-        for w in d.windows(3) {
-            let (x1, x2, y) = (w[1], w[0], w[2]);
-            s11 += x1 * x1;
-            s12 += x1 * x2;
-            s22 += x2 * x2;
-            r1 += x1 * y;
-            r2 += x2 * y;
-        }
-    }
-    let det = s11 * s22 - s12 * s12;
-    let a = (r1 * s22 - r2 * s12) / det;
-    let b = (s11 * r2 - s12 * r1) / det;
-    let disc = Complex64::new(a * a + 4.0 * b, 0.0).sqrt();
-    let z1 = (Complex64::new(a, 0.0) + disc) / 2.0;
-    let z2 = (Complex64::new(a, 0.0) - disc) / 2.0;
-    let z = if z1.norm() >= z2.norm() { z1 } else { z2 };
-    if z.im < 0.0 { z.conj() } else { z }
-}
+#[path = "../transient.rs"]
+mod transient;
+use transient::{deterministic, fit_multiplier, peak, rms, upper};
 
 fn stable(
     name: &str,
@@ -52,9 +29,7 @@ fn stable(
     let tau = model.operation().delay_s(rpm);
     let fs = per_delay as f64 / tau;
     let dur = (k.1 + 3) as f64 * tau;
-    let mut s = SimulationSettings::new(rpm, depth_mm * 1e-3, dur, fs, 1);
-    s.quantity = Quantity::Displacement;
-    s.random_force_rms_n = 0.0;
+    let s = deterministic(rpm, depth_mm * 1e-3, dur, fs);
     let t0 = Instant::now();
     let sim = simulate(model, &s).unwrap();
     let el = t0.elapsed().as_secs_f64();
@@ -64,16 +39,13 @@ fn stable(
         .map(|c| (k.0..k.1).map(|i| c.data[i * per_delay]).collect())
         .collect();
     let mu = fit_multiplier(&seqs);
-    let reference = Discretization::full()
-        .monodromy(model, rpm, depth_mm * 1e-3)
-        .unwrap()
-        .dominant_eigenvalue()
-        .unwrap();
-    let reference = if reference.im < 0.0 {
-        reference.conj()
-    } else {
-        reference
-    };
+    let reference = upper(
+        Discretization::full()
+            .monodromy(model, rpm, depth_mm * 1e-3)
+            .unwrap()
+            .dominant_eigenvalue()
+            .unwrap(),
+    );
     println!(
         "{name:28} simulated mu |{:.5}| arg {:.5}   monodromy |{:.5}| arg {:.5}   d|mu| {:+.5}  lost {:.5}  ({el:.2} s)",
         mu.norm(),
@@ -85,39 +57,8 @@ fn stable(
     );
 }
 
-fn rms(x: &[f64]) -> f64 {
-    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
-}
-
-/// Peak of the Hann-windowed spectrum: (frequency by parabolic interpolation, amplitude).
-fn peak(x: &[f64], fs: f64) -> (f64, f64) {
-    let n = x.len();
-    let mean = x.iter().sum::<f64>() / n as f64;
-    let mut buf: Vec<Complex64> = x
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
-            Complex64::new((v - mean) * w, 0.0)
-        })
-        .collect();
-    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
-    let mag: Vec<f64> = buf[..n / 2].iter().map(|c| c.norm()).collect();
-    let (i, _) = mag
-        .iter()
-        .enumerate()
-        .skip(2)
-        .max_by(|a, b| a.1.total_cmp(b.1))
-        .unwrap();
-    let (a, b, c) = (mag[i - 1].ln(), mag[i].ln(), mag[i + 1].ln());
-    let d = 0.5 * (a - c) / (a - 2.0 * b + c);
-    ((i as f64 + d) * fs / n as f64, 4.0 * mag[i] / n as f64)
-}
-
 fn chatter(name: &str, model: &ModalModel, rpm: f64, depth_mm: f64, fs: f64, dur: f64) {
-    let mut s = SimulationSettings::new(rpm, depth_mm * 1e-3, dur, fs, 1);
-    s.quantity = Quantity::Displacement;
-    s.random_force_rms_n = 0.0;
+    let s = deterministic(rpm, depth_mm * 1e-3, dur, fs);
     let t0 = Instant::now();
     let sim = simulate(model, &s).unwrap();
     let el = t0.elapsed().as_secs_f64();

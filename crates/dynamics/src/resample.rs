@@ -64,21 +64,7 @@ impl<const N: usize> Resampler<N> {
         let f_eff = output_rate_hz.min(1.0 / input_step_s);
         let fc = CUTOFF_FRACTION * f_eff;
         let half_width_s = HALF_WIDTH_PERIODS / f_eff;
-        let kernel = |i: usize| {
-            let t = half_width_s * i as f64 / TABLE_POINTS as f64;
-            let x = 2.0 * fc * t;
-            let sinc = if x == 0.0 {
-                1.0
-            } else {
-                (PI * x).sin() / (PI * x)
-            };
-            // Blackman window over [-W, W], evaluated at t >= 0
-            let u = PI * (t / half_width_s + 1.0);
-            let w = 0.42 - 0.5 * u.cos() + 0.08 * (2.0 * u).cos();
-            sinc * w
-        };
-        let half: Vec<f64> = (0..=TABLE_POINTS).map(kernel).collect();
-        // the kernel at any t (zero outside [-W, W]), for the polyphase rows
+        // the Blackman-windowed sinc at any t (zero outside [-W, W])
         let exact = |t: f64| {
             let t = t.abs();
             if t >= half_width_s {
@@ -93,6 +79,9 @@ impl<const N: usize> Resampler<N> {
             let u = PI * (t / half_width_s + 1.0);
             sinc * (0.42 - 0.5 * u.cos() + 0.08 * (2.0 * u).cos())
         };
+        let half: Vec<f64> = (0..=TABLE_POINTS)
+            .map(|i| exact(half_width_s * i as f64 / TABLE_POINTS as f64))
+            .collect();
         // phases spaced no wider than the table's points
         let phases = ((input_step_s * TABLE_POINTS as f64 / half_width_s).ceil() as usize).max(1);
         let taps = (2.0 * half_width_s / input_step_s).floor() as usize + 2;

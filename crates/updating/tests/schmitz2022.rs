@@ -320,7 +320,10 @@ fn sec6_replayed_sequences_stop_by_the_rules_and_match_the_paper() {
             .fold(f64::NAN, f64::max);
         // (the observation holds the cut's depth in mm, the plan in m: equal to rounding)
         let best = best.unwrap_or(f64::NAN);
-        assert!((best - stable_best).abs() <= 1e-12 * stable_best, "{best} vs {stable_best}");
+        assert!(
+            (best - stable_best).abs() <= 1e-12 * stable_best,
+            "{best} vs {stable_best}"
+        );
         // an unstable test carries a chatter frequency, a stable one none
         assert!(r.tests.iter().all(|t| t.stable == t.chatter_hz.is_none()));
     }
