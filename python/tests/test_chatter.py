@@ -4,6 +4,7 @@ numbers bit-equal to the command line's for the same seed, interruption, ArviZ o
 import _thread
 import csv
 import json
+import re
 import threading
 import time
 
@@ -144,10 +145,17 @@ def test_oma_of_an_observations_file_equals_the_cli(cli, tmp_path):
     both = {"cuts": [], "signals": [stable, chattering]}
     with pytest.raises(ValueError, match=r"signals\[1\].*chatter detection calls this record"):
         chatter.oma_observations(both, model=TURNING_MODEL)
-    # allowed through, the chattering record still gives no pole: its limit cycle is a spectral
-    # line and what remains lies in the noise floor (the identification's noise-floor rule)
-    with pytest.raises(ValueError, match=r"signals\[1\].*no pole identified.*spectral line"):
-        chatter.oma_observations(both, model=TURNING_MODEL, allow_chatter=True)
+    # allowed through, the chattering record is identified with its limit cycle rejected as a
+    # spectral line, and its pole carries the detection's flag, never passed as a clean one
+    flagged = chatter.oma_observations(both, model=TURNING_MODEL, allow_chatter=True)
+    chattering_pole = flagged["observations"]["poles"][1]
+    assert chattering_pole["depth_mm"] == chattering["depth_mm"]
+    detected = re.search(r"FLAGGED: chatter detection calls the record chatter at ([0-9.]+) Hz",
+                         chattering_pole["note"])
+    assert detected, chattering_pole["note"]
+    note = chattering_pole["note"]
+    lines = [float(f) for f in re.findall(r"([0-9.]+) Hz \(SpectralLine\)", note)]
+    assert any(abs(f - float(detected.group(1))) < 1.0 for f in lines), note
 
 
 # --- the same numbers as the command line ---------------------------------------------------
