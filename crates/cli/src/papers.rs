@@ -6,10 +6,7 @@ use anyhow::Result;
 use chatter_dynamics::examples;
 use chatter_progress::Silent;
 use chatter_uncertainty::geometric::{OffsetBoundaries, schmitz2023};
-use chatter_uncertainty::sensitivity::{
-    TABLE3_MODE2, TABLE3_MODE2_PARAMETERS, TABLE3_STEPS_PER_REVOLUTION, TransitionMap,
-    pole_sensitivity,
-};
+use chatter_uncertainty::sensitivity::{TABLE3_MODE2, table3_mode2};
 use chatter_updating::{ebrahimi2025, karandikar, schmitz2022};
 use std::fmt::Write as _;
 
@@ -40,23 +37,11 @@ impl Row {
 /// 000 Table 3 (Sec. 6.2): |d mu / d theta| of the one-step map, 200 steps per revolution, for
 /// mode 2 at P1-P5; tolerance 3 % of the paper's value.
 fn ahmadi_table_3() -> Result<Vec<Row>> {
-    let model = examples::ahmadi_2022_turning();
-    let names = TABLE3_MODE2_PARAMETERS;
-    let params = names
-        .iter()
-        .map(|s| s.parse())
-        .collect::<Result<Vec<_>, _>>()?;
+    let sensitivities = table3_mode2(&examples::ahmadi_2022_turning())?;
     let mut rows = Vec::new();
-    for (point, rpm, mm, paper) in TABLE3_MODE2 {
-        let s = pole_sensitivity(
-            &model,
-            &params,
-            rpm,
-            mm * 1e-3,
-            TABLE3_STEPS_PER_REVOLUTION,
-            TransitionMap::OneStep,
-        )?;
-        for ((entry, name), p) in s.entries.iter().zip(names).zip(paper) {
+    for ((point, rpm, mm, paper), s) in TABLE3_MODE2.iter().zip(&sensitivities) {
+        for (entry, &p) in s.entries.iter().zip(paper) {
+            let name = entry.parameter;
             rows.push(Row {
                 source: "000 Table 3".into(),
                 quantity: format!("|dmu/d{name}| at {point} ({rpm} rpm, {mm} mm)"),

@@ -21,7 +21,7 @@
 //! single one-step eigenvalue; only the period map is offered there.
 
 use crate::error::{Result, UncertaintyError};
-use chatter_dynamics::{ModalModel, Operation, Parameter};
+use chatter_dynamics::{ModalModel, Operation, Parameter, ParameterKind};
 use chatter_stability::StabilitySolver;
 use chatter_stability::monodromy::{Discretization, steps};
 use num_complex::Complex64;
@@ -31,8 +31,22 @@ use std::num::NonZeroUsize;
 /// Steps per revolution of the sensitivities of 000 Table 3.
 pub const TABLE3_STEPS_PER_REVOLUTION: NonZeroUsize = steps::<200>();
 
-/// The parameters of 000 Table 3's mode-2 columns, in [`TABLE3_MODE2`]'s order.
-pub const TABLE3_MODE2_PARAMETERS: [&str; 3] = ["theta_omega_2", "theta_zeta_2", "theta_phi_2"];
+/// The parameters of 000 Table 3's mode-2 columns, in [`TABLE3_MODE2`]'s order:
+/// theta_omega_2, theta_zeta_2, theta_phi_2.
+pub const TABLE3_MODE2_PARAMETERS: [Parameter; 3] = [
+    Parameter {
+        kind: ParameterKind::Omega,
+        mode: 1,
+    },
+    Parameter {
+        kind: ParameterKind::Zeta,
+        mode: 1,
+    },
+    Parameter {
+        kind: ParameterKind::Phi,
+        mode: 1,
+    },
+];
 
 /// 000 Table 3's mode-2 rows as printed (2-4 significant digits): the point, its speed (rpm)
 /// and depth (mm), and |d mu / d theta| for [`TABLE3_MODE2_PARAMETERS`].
@@ -86,6 +100,25 @@ pub struct PoleSensitivity {
     pub chatter_hz: f64,
     /// One entry per parameter, in the order asked.
     pub entries: Vec<ParameterSensitivity>,
+}
+
+/// 000 Table 3's mode-2 rows recomputed on `model` (seed 000's lathe for the paper's values):
+/// [`pole_sensitivity`] of the one-step map at [`TABLE3_STEPS_PER_REVOLUTION`] for
+/// [`TABLE3_MODE2_PARAMETERS`] at each condition of [`TABLE3_MODE2`], in its order.
+pub fn table3_mode2(model: &ModalModel) -> Result<Vec<PoleSensitivity>> {
+    TABLE3_MODE2
+        .iter()
+        .map(|&(_, rpm, mm, _)| {
+            pole_sensitivity(
+                model,
+                &TABLE3_MODE2_PARAMETERS,
+                rpm,
+                mm * 1e-3,
+                TABLE3_STEPS_PER_REVOLUTION,
+                TransitionMap::OneStep,
+            )
+        })
+        .collect()
 }
 
 /// Eq. 15 at one cutting condition (depth in m) for `parameters`, on the `map`'s dominant
@@ -163,20 +196,8 @@ mod tests {
     #[test]
     fn table3_mode2_rows() {
         let model = examples::ahmadi_2022_turning();
-        let params: Vec<Parameter> = TABLE3_MODE2_PARAMETERS
-            .iter()
-            .map(|s| s.parse().unwrap())
-            .collect();
-        for (_, rpm, mm, paper) in TABLE3_MODE2 {
-            let one = pole_sensitivity(
-                &model,
-                &params,
-                rpm,
-                mm * 1e-3,
-                TABLE3_STEPS_PER_REVOLUTION,
-                TransitionMap::OneStep,
-            )
-            .unwrap();
+        let rows = table3_mode2(&model).unwrap();
+        for ((_, rpm, mm, paper), one) in TABLE3_MODE2.iter().zip(&rows) {
             for (e, p) in one.entries.iter().zip(paper) {
                 let rel = (e.modulus() - p).abs() / p;
                 assert!(
