@@ -36,7 +36,8 @@ pub(crate) struct Resampler<const N: usize> {
     output_rate_hz: f64,
     half_width_s: f64,
     /// The kernel over [-W, W] at 2 [`TABLE_POINTS`] + 1 points, each with the difference to
-    /// the next (zero past the end), so one load gives both ends of the interpolation.
+    /// the next (zero past the end), so one load gives both ends of the interpolation; built
+    /// only when the polyphase rows are not (empty otherwise).
     table: Vec<[f64; 2]>,
     /// Table points per second of kernel argument.
     table_scale: f64,
@@ -79,34 +80,41 @@ impl<const N: usize> Resampler<N> {
             let u = PI * (t / half_width_s + 1.0);
             sinc * (0.42 - 0.5 * u.cos() + 0.08 * (2.0 * u).cos())
         };
-        let half: Vec<f64> = (0..=TABLE_POINTS)
-            .map(|i| exact(half_width_s * i as f64 / TABLE_POINTS as f64))
-            .collect();
         // phases spaced no wider than the table's points
         let phases = ((input_step_s * TABLE_POINTS as f64 / half_width_s).ceil() as usize).max(1);
         let taps = (2.0 * half_width_s / input_step_s).floor() as usize + 2;
-        let (mut poly_value, mut poly_slope) = (Vec::new(), Vec::new());
+        let (mut poly_value, mut poly_slope, mut table) = (Vec::new(), Vec::new(), Vec::new());
         if (phases + 1).saturating_mul(taps) <= 1 << 21 {
-            let row = |q: usize| {
-                (0..taps).map(move |i| {
-                    exact(-half_width_s + (i as f64 + q as f64 / phases as f64) * input_step_s)
+            // rows 0..=phases, each evaluated once: row q is the values, row q + 1 - row q the
+            // slopes
+            let rows: Vec<f64> = (0..=phases)
+                .flat_map(|q| {
+                    (0..taps).map(move |i| {
+                        exact(-half_width_s + (i as f64 + q as f64 / phases as f64) * input_step_s)
+                    })
                 })
-            };
-            for q in 0..phases {
-                poly_value.extend(row(q));
-                poly_slope.extend(row(q + 1).zip(row(q)).map(|(b, a)| b - a));
-            }
+                .collect();
+            poly_value = rows[..phases * taps].to_vec();
+            poly_slope = rows[taps..]
+                .iter()
+                .zip(&poly_value)
+                .map(|(b, a)| b - a)
+                .collect();
+        } else {
+            // symmetric table over [-W, W]: point i at t = (i - TABLE_POINTS) W / TABLE_POINTS
+            let values: Vec<f64> = (0..=2 * TABLE_POINTS)
+                .map(|i| {
+                    let from_centre = i.abs_diff(TABLE_POINTS);
+                    exact(half_width_s * from_centre as f64 / TABLE_POINTS as f64)
+                })
+                .chain([0.0])
+                .collect();
+            table = values
+                .windows(2)
+                .map(|w| [w[0], w[1] - w[0]])
+                .chain([[0.0, 0.0]])
+                .collect();
         }
-        // symmetric table over [-W, W]: point i at t = (i - TABLE_POINTS) W / TABLE_POINTS
-        let values: Vec<f64> = (0..=2 * TABLE_POINTS)
-            .map(|i| half[i.abs_diff(TABLE_POINTS)])
-            .chain([0.0])
-            .collect();
-        let table = values
-            .windows(2)
-            .map(|w| [w[0], w[1] - w[0]])
-            .chain([[0.0, 0.0]])
-            .collect();
         Self {
             input_step_s,
             output_rate_hz,
@@ -147,7 +155,6 @@ impl<const N: usize> Resampler<N> {
     /// Write every output complete once the input reaches `last_time`.
     fn write_outputs(&mut self, last_time: f64, out: &mut [Vec<f64>; N]) {
         let n_out = out[0].len();
-        let last_point = self.table.len() - 1;
         while self.next < n_out {
             let ts = self.next as f64 / self.output_rate_hz;
             if ts + self.half_width_s > last_time {
@@ -217,7 +224,7 @@ impl<const N: usize> Resampler<N> {
                 let dx = self.input_step_s * self.table_scale;
                 for v in &self.buffer[lo - self.first..=hi - self.first] {
                     // x >= 0 up to rounding (a negative x saturates to point 0)
-                    let i = (x as usize).min(last_point);
+                    let i = (x as usize).min(self.table.len() - 1);
                     let [g0, dg] = self.table[i];
                     let g = g0 + (x - i as f64) * dg;
                     for c in 0..N {

@@ -332,6 +332,8 @@ pub fn simulate_with_observer(
     let steps_per_rev = steps_per_delay * edges;
     let step_angle = 2.0 * PI / steps_per_rev as f64;
     let (step_sin, step_cos) = step_angle.sin_cos();
+    // (sin, cos) of an angle advanced by one step
+    let rotated = |[s, c]: [f64; 2]| [s * step_cos + c * step_sin, c * step_cos - s * step_sin];
     let (entry_steps, exit_steps) = match milling {
         Some((entry, exit)) => (entry / step_angle, exit / step_angle),
         None => (0.0, 0.0),
@@ -340,6 +342,8 @@ pub fn simulate_with_observer(
     let mut tooth_index = vec![0usize; edges];
     // (sin, cos) of each tooth angle, rotated by the step angle and recomputed every delay
     let mut tooth_sc = vec![[0.0f64, 1.0f64]; edges];
+    // force direction u of a milling edge whose chip direction is (sin phi, cos phi)
+    let milling_force_direction = |[s, c]: [f64; 2]| [kt * c + kn * s, -kt * s + kn * c];
     let omega_spindle = 2.0 * PI * settings.speed_rpm / 60.0;
     let feed_speed = settings.feed_per_tooth_m / tau; // m/s along x (milling) or feed (turning)
     let b = settings.depth_m;
@@ -395,8 +399,7 @@ pub fn simulate_with_observer(
                 }
             } else {
                 for (sc, index) in tooth_sc.iter_mut().zip(&mut tooth_index) {
-                    let [s, c] = *sc;
-                    *sc = [s * step_cos + c * step_sin, c * step_cos - s * step_sin];
+                    *sc = rotated(*sc);
                     *index = if *index + 1 == steps_per_rev {
                         0
                     } else {
@@ -410,12 +413,11 @@ pub fn simulate_with_observer(
             let (n_dir, u, in_cut, (a, z)) = match milling {
                 None => ([1.0, 0.0], [kn, kt], true, (0.0, 1.0)),
                 Some((entry, exit)) => {
-                    let [s, c] = tooth_sc[j];
                     let index = tooth_index[j] as f64;
                     let p = index * step_angle;
                     (
-                        [s, c],
-                        [kt * c + kn * s, -kt * s + kn * c],
+                        tooth_sc[j],
+                        milling_force_direction(tooth_sc[j]),
                         p >= entry && p <= exit,
                         (
                             (entry_steps - index).clamp(0.0, 1.0),
@@ -458,16 +460,13 @@ pub fn simulate_with_observer(
                     // first step in the cut (the previous step has no chip to extrapolate
                     // from): the chip at the end of the step on the surface the previous edge
                     // cut there one delay ago, with the displacement extrapolated by the velocity
-                    let [s, c] = tooth_sc[j];
-                    let n_end = [s * step_cos + c * step_sin, c * step_cos - s * step_sin];
-                    let u_end = match milling {
-                        None => u,
-                        Some(_) => [
-                            kt * n_end[1] + kn * n_end[0],
-                            -kt * n_end[0] + kn * n_end[1],
-                        ],
+                    let (n_end, u_end) = match milling {
+                        None => (n_dir, u),
+                        Some(_) => {
+                            let n_end = rotated(tooth_sc[j]);
+                            (n_end, milling_force_direction(n_end))
+                        }
                     };
-                    let n_end = if milling.is_some() { n_end } else { n_dir };
                     let x_end = [x[0] + v[0] * h, x[1] + v[1] * h];
                     let e_end = n_end[0] * (feed_speed * (t + h) - x_end[0]) - n_end[1] * x_end[1];
                     let s_next = surface[((slot + 1) % steps_per_delay) * edges + prev_edge];
