@@ -10,11 +10,13 @@
 //! with the lapse probability (a limit cycle settled on another root, a spurious identified
 //! pole), so one outlier alone must not fail the check, while many large residuals still do;
 //! against the uncapped chi-square law the p-value is lenient, never smaller than without the
-//! cap. The best class fails when the smallest p-value is below the family-wise level divided by
-//! the number of observable types (Bonferroni).
+//! cap. A fifth p-value is the localized check's ([`crate::local`]): the misfit of the worst band
+//! of speeds. The best class fails when the smallest p-value is below the family-wise level
+//! divided by the number of p-values (Bonferroni).
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals};
+use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals, terms};
+use crate::local::{LocalCheck, local_check};
 use crate::predict::Prediction;
 use chatter_bayes::special::normal_cdf;
 use rand::rngs::StdRng;
@@ -38,10 +40,34 @@ pub struct PredictiveCheck {
     pub pole_frequencies: Option<f64>,
     /// Pole damping ratios.
     pub pole_damping: Option<f64>,
+    /// The localized check: the band of speeds where the misfit concentrates most, and its
+    /// p-value ([`crate::local`]).
+    pub local: Option<LocalCheck>,
     /// The family-wise level the smallest p-value is held to.
     pub level: f64,
     /// Whether the class explains the data at that level.
     pub passed: bool,
+}
+
+impl PredictiveCheck {
+    /// The band of speeds (rpm) whose localized check fails at the Bonferroni level: where the
+    /// misfit concentrates beyond what the noise allows ([`crate::local`]).
+    pub fn failing_band(&self) -> Option<(f64, f64)> {
+        let types = [
+            self.cut_labels,
+            self.chatter_frequencies,
+            self.pole_frequencies,
+            self.pole_damping,
+            self.local.map(|l| l.p_value),
+        ]
+        .iter()
+        .flatten()
+        .count()
+        .max(1) as f64;
+        self.local
+            .filter(|l| l.p_value < self.level / types)
+            .map(|l| (l.from_rpm, l.to_rpm))
+    }
 }
 
 /// P(chi^2_n >= t) by the Wilson-Hilferty approximation.
@@ -106,6 +132,7 @@ pub(crate) fn predictive_check(
             chatter_p.push(chi_square_tail(chatter.iter().sum(), chatter.len()));
         }
         if !data.poles.is_empty() {
+            let scale = terms(pred, data, noise).pole_scale;
             let (mut tf, mut tz) = (0.0, 0.0);
             for (i, p) in data.poles.iter().enumerate() {
                 match pred.poles[i] {
@@ -116,7 +143,7 @@ pub(crate) fn predictive_check(
                             &q,
                             pred.pole_fold_hz[i],
                         );
-                        tf += (rf / p.frequency_std_hz).powi(2).min(OUTLIER_CAP);
+                        tf += (rf / p.frequency_std_hz(scale)).powi(2).min(OUTLIER_CAP);
                         tz += (rz / p.damping_std).powi(2).min(OUTLIER_CAP);
                     }
                     // a failed prediction is neither a misfit nor a fit
@@ -131,11 +158,13 @@ pub(crate) fn predictive_check(
         }
     }
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    let local = local_check(predictions, data, noise, seed);
     let values = [
         mean(&label_p),
         mean(&chatter_p),
         mean(&pole_f_p),
         mean(&pole_z_p),
+        local.map(|l| l.p_value),
     ];
     let types = values.iter().flatten().count().max(1) as f64;
     let smallest = values.iter().flatten().copied().fold(1.0, f64::min);
@@ -144,6 +173,7 @@ pub(crate) fn predictive_check(
         chatter_frequencies: values[1],
         pole_frequencies: values[2],
         pole_damping: values[3],
+        local,
         level,
         passed: smallest >= level / types,
     }

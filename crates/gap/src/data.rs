@@ -3,7 +3,10 @@
 
 use crate::error::{GapError, Result};
 use crate::likelihood::NoiseModel;
+use crate::predict::milling_multiplier;
+use crate::variant::Variant;
 use chatter_dynamics::{ModalModel, Observations, Operation};
+use rayon::prelude::*;
 
 /// A test cut.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,7 +35,13 @@ pub(crate) struct PolePoint {
     pub depth_m: f64,
     pub frequency_hz: f64,
     pub damping_ratio: f64,
-    pub frequency_std_hz: f64,
+    /// The reported standard deviation of the frequency (Hz; 0 when none): the floor of the
+    /// noise model's ([`PolePoint::frequency_std_hz`]).
+    pub frequency_floor_hz: f64,
+    /// The frequency the noise scale s multiplies: the pole's own for a physical (turning)
+    /// pole, the dominant natural frequency for a lifted (milling) one, whose principal
+    /// frequency carries the absolute error of the physical pole it folds.
+    pub frequency_unit_hz: f64,
     pub damping_std: f64,
     pub sequence: Option<i64>,
     pub u: f64,
@@ -52,6 +61,23 @@ pub(crate) struct Dataset {
     pub has_sequence: bool,
     /// Standard deviation of chatter frequencies (Hz).
     pub chatter_std_hz: f64,
+    /// The grid of relative pole-frequency noise scales s the likelihood integrates over
+    /// ([`NoiseModel::pole_scales`]).
+    pub pole_scales: Vec<f64>,
+    /// Milling: the nominal model's start vector of each cut's and each pole's operator
+    /// ([`crate::predict::milling_multiplier`]), where its solver succeeded; empty for turning.
+    pub cut_starts: Vec<Option<Vec<f64>>>,
+    /// As `cut_starts`, for the poles.
+    pub pole_starts: Vec<Option<Vec<f64>>>,
+}
+
+impl PolePoint {
+    /// Standard deviation of the pole frequency at relative noise scale `scale`: the larger of
+    /// s times [`PolePoint::frequency_unit_hz`] and the reported one (an identification's
+    /// scatter over overlapping segments leaves out its bias, so it is a floor, not the noise).
+    pub fn frequency_std_hz(&self, scale: f64) -> f64 {
+        self.frequency_floor_hz.max(scale * self.frequency_unit_hz)
+    }
 }
 
 impl Dataset {
@@ -139,12 +165,12 @@ impl Dataset {
                 depth_m: p.depth_mm * 1e-3,
                 frequency_hz: p.frequency_hz,
                 damping_ratio: p.damping_ratio,
-                // the larger of the reported and the noise model's standard deviation: an
-                // identification's scatter over (overlapping) segments leaves out its bias
-                frequency_std_hz: p
-                    .frequency_std_hz
-                    .unwrap_or(0.0)
-                    .max(noise.pole_frequency_std_fraction * reference_hz),
+                frequency_floor_hz: p.frequency_std_hz.unwrap_or(0.0),
+                frequency_unit_hz: if milling {
+                    reference_hz
+                } else {
+                    p.frequency_hz.abs()
+                },
                 damping_std: p.damping_std.unwrap_or(0.0).max(
                     noise.pole_damping_std_relative * p.damping_ratio.abs()
                         + noise.pole_damping_std_floor,
@@ -161,9 +187,50 @@ impl Dataset {
             immersions,
             has_sequence,
             chatter_std_hz: noise.chatter_std_fraction * reference_hz,
+            pole_scales: noise.pole_scales(),
+            cut_starts: Vec::new(),
+            pole_starts: Vec::new(),
         };
         data.index_requests();
+        if milling {
+            data.nominal_starts(model);
+        }
         Ok(data)
+    }
+
+    /// The nominal model's start vectors (in parallel over the observations).
+    fn nominal_starts(&mut self, model: &ModalModel) {
+        let nominal = Variant::new(model.clone());
+        let start = |speed_rpm: f64, depth_m: f64, geometry: usize, u: f64| {
+            let m = nominal
+                .at(
+                    self.immersions.get(geometry).copied().flatten(),
+                    speed_rpm,
+                    u,
+                )
+                .ok()?;
+            milling_multiplier(&m, speed_rpm, depth_m, None).map(|(_, v)| v)
+        };
+        self.cut_starts = self
+            .cuts
+            .par_iter()
+            .map(|c| start(c.speed_rpm, c.depth_m, c.geometry, c.u))
+            .collect();
+        self.pole_starts = self
+            .poles
+            .par_iter()
+            .map(|p| start(p.speed_rpm, p.depth_m, p.geometry, p.u))
+            .collect();
+    }
+
+    /// The start vector of cut `k` (milling), if any.
+    pub fn cut_start(&self, k: usize) -> Option<&[f64]> {
+        self.cut_starts.get(k).and_then(Option::as_deref)
+    }
+
+    /// The start vector of pole `k` (milling), if any.
+    pub fn pole_start(&self, k: usize) -> Option<&[f64]> {
+        self.pole_starts.get(k).and_then(Option::as_deref)
     }
 
     fn index_requests(&mut self) {
@@ -182,6 +249,14 @@ impl Dataset {
 
     /// The cuts and poles at the given positions (into `cuts` and `poles`), sharing geometries.
     pub fn subset(&self, cuts: &[usize], poles: &[usize]) -> Self {
+        let pick = |starts: &[Option<Vec<f64>>], at: &[usize]| -> Vec<Option<Vec<f64>>> {
+            if starts.is_empty() {
+                return Vec::new();
+            }
+            at.iter()
+                .map(|&i| starts.get(i).cloned().flatten())
+                .collect()
+        };
         let mut data = Self {
             cuts: cuts
                 .iter()
@@ -195,6 +270,9 @@ impl Dataset {
             immersions: self.immersions.clone(),
             has_sequence: self.has_sequence,
             chatter_std_hz: self.chatter_std_hz,
+            pole_scales: self.pole_scales.clone(),
+            cut_starts: pick(&self.cut_starts, cuts),
+            pole_starts: pick(&self.pole_starts, poles),
         };
         data.index_requests();
         data
@@ -258,7 +336,8 @@ mod tests {
         // (5000, 0), (5000, 1), (6000, 0)
         assert_eq!(data.requests.len(), 3);
         assert_eq!(data.cuts[3].request, data.cuts[0].request);
-        assert!((data.poles[0].frequency_std_hz - 0.003 * 750.0).abs() < 1e-12);
+        // a lifted (milling) pole's noise scales with the reference frequency
+        assert!((data.poles[0].frequency_std_hz(0.01) - 0.01 * 750.0).abs() < 1e-12);
         // a reported standard deviation above the noise model's floor (0.15 * 0.2 + 0.002) is kept
         assert_eq!(data.poles[0].damping_std, 0.05);
         let sub = data.subset(&[2, 3], &[]);

@@ -674,6 +674,19 @@ pub fn diagnose(
     } else {
         Verdict::Unexplained
     };
+    if verdict == Verdict::Unexplained
+        && let (Some((from, to)), Some(local)) = (check.failing_band(), check.local)
+    {
+        notes.push(format!(
+            "the misfit that the best class ({}) leaves concentrates between {from:.0} and \
+             {to:.0} rpm ({} observations, band score {:.1}, p = {:.2e}): an effect confined to \
+             that band of speeds, which none of the tried classes describes",
+            best_class.name(),
+            local.observations,
+            local.score,
+            local.p_value
+        ));
+    }
     let classes = fitted
         .iter()
         .zip(&probabilities)

@@ -18,7 +18,7 @@
 //! and the diagnosis calls the data `consistent` with the nominal model.
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, chatter_residual, pole_frequency_residual};
+use crate::likelihood::{NoiseModel, chatter_residual, pole_frequency_residual, terms};
 use crate::predict::{CutPrediction, Prediction};
 
 /// Half-width, in label widths, of the band of log-depth distances where a cut's label is
@@ -46,11 +46,13 @@ pub(crate) fn largest_shift(
         });
         Some(label.max(chatter))
     });
+    // the poles' noise at the scale the data imply under the base model
+    let scale = terms(base, data, noise).pole_scale;
     let poles = data.poles.iter().enumerate().filter_map(|(i, p)| {
         let (b, o) = (base.poles[i]?, other.poles[i]?);
         let frequency =
             pole_frequency_residual(o.frequency_hz, b.frequency_hz, base.pole_fold_hz[i]).abs()
-                / p.frequency_std_hz;
+                / p.frequency_std_hz(scale);
         let damping = (o.damping_ratio - b.damping_ratio).abs() / p.damping_std;
         Some(frequency.max(damping))
     });

@@ -30,7 +30,31 @@
 //! mean evidence does not beat its likelihood (a class without parameters) by a Bayes factor of
 //! 10, or the best class is practically equivalent to it ([`equivalence`]: no observation's
 //! prediction moves by more than one noise standard deviation); otherwise the best class when it
-//! passes the check; otherwise `unexplained`.
+//! passes the check; otherwise `unexplained`. The check includes a localized scan over bands of
+//! speeds ([`local`]); when that part fails, the `unexplained` verdict names the band.
+//!
+//! # Outside proving ground
+//! Twenty campaigns of an outside generator (`../shared/data/gap_public`, its README; truth a
+//! converged first-order full discretization, turning poles the rightmost characteristic root,
+//! 1 % pole-frequency noise), diagnosed at the defaults, seed 1, validation off
+//! (`cargo run --release -p chatter-gap --example confusion -- --public ../shared/data/gap_public`;
+//! `tests/public_campaigns.rs` holds the turning campaigns and a control):
+//!
+//! | machine | control | 1x | 2x | outside the list |
+//! |---|---|---|---|---|
+//! | A: xy milling 30 % | 1/1 | 2/2 (parameter error, speed-dependent dynamics) | 1/1 (process damping) | 0/1 (cutting x3 in a band: `consistent`, nominal misses 4/40) |
+//! | B: low immersion | 1/1 | 0/1 (drift taken for `extra_mode`) | 1/2 (parameter error right; extra mode `unexplained`) | 0/1 (damping band: `parameter_error`) |
+//! | C: turning | 1/1 | 2/2 (process damping, extra mode) | 1/1 (speed-dependent dynamics) | 0/1 (cutting rising at low speed: `process_damping`) |
+//! | D: two modes in x | 1/1 | 1/1 (parameter error) | 2/2 (drift, process damping) | 1/1 (`consistent`, nominal misses 1/40) |
+//!
+//! 15/20 right (before this version 10/20: every turning campaign `unexplained`, because the
+//! likelihood held pole frequencies to 0.3 % while the identification scatters by 1 %; the noise
+//! scale is now integrated out, [`likelihood`]); every control `consistent`; median held-out
+//! closure 0.67 over the 13 campaigns with a gap (nominal misses >= 2 of 40). Still missed: three of
+//! four effects outside the list (a gap confined to one or two observations of a band is not
+//! told from an outlier by the localized check), drift 1x and extra mode 2x on the
+//! low-immersion machine. Time per campaign 45-260 s on the shared two cores (three other jobs
+//! running); the 30 s target for a 40-cut, 8-pole campaign is not met.
 //!
 //! # Model: which approximation is used where
 //! - **Inside the samplers and the checks** every prediction is one Floquet multiplier of the
@@ -96,6 +120,7 @@ pub mod equivalence;
 pub mod error;
 pub mod generator;
 pub mod likelihood;
+pub mod local;
 pub mod predict;
 pub mod regions;
 pub mod shrink;
@@ -107,4 +132,5 @@ pub use diagnose::{DiagnoseOptions, Diagnosis, LobeComparison, Validation, Verdi
 pub use error::{GapError, Result};
 pub use generator::{HiddenEffect, Recalibration, RunOrder, Scenario, nominal_milling, synthesize};
 pub use likelihood::NoiseModel;
+pub use local::LocalCheck;
 pub use variant::Variant;

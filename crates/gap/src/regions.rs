@@ -12,7 +12,7 @@
 //! the total misfit of the nominal model.
 
 use crate::data::Dataset;
-use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals};
+use crate::likelihood::{NoiseModel, nearest_chatter_residual, pole_residuals, terms};
 use crate::predict::Prediction;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -113,11 +113,14 @@ pub(crate) fn residuals(prediction: &Prediction, data: &Dataset, noise: &NoiseMo
             }
         })
         .collect();
+    // the poles' noise at the scale the data imply under this prediction
+    let scale = terms(prediction, data, noise).pole_scale;
     let poles = data
         .poles
         .iter()
         .enumerate()
         .map(|(i, p)| {
+            let frequency_std = p.frequency_std_hz(scale);
             let (fr, zr) = prediction.poles[i].map_or((f64::NAN, f64::NAN), |q| {
                 pole_residuals(
                     p.frequency_hz,
@@ -127,7 +130,7 @@ pub(crate) fn residuals(prediction: &Prediction, data: &Dataset, noise: &NoiseMo
                 )
             });
             let misfit = if fr.is_finite() {
-                0.5 * (fr / p.frequency_std_hz).powi(2) + 0.5 * (zr / p.damping_std).powi(2)
+                0.5 * (fr / frequency_std).powi(2) + 0.5 * (zr / p.damping_std).powi(2)
             } else {
                 0.0
             };

@@ -142,10 +142,26 @@ pub(crate) fn recalibrated(
     damping_factor: f64,
     cutting_factor: f64,
 ) -> Result<ModalModel> {
+    recalibrated_per_mode(
+        model,
+        &vec![frequency_factor; model.modes().len()],
+        damping_factor,
+        cutting_factor,
+    )
+}
+
+/// [`recalibrated`] with one frequency factor per mode (in the model's order).
+pub(crate) fn recalibrated_per_mode(
+    model: &ModalModel,
+    frequency_factors: &[f64],
+    damping_factor: f64,
+    cutting_factor: f64,
+) -> Result<ModalModel> {
     let modes = model
         .modes()
         .iter()
-        .map(|m| recalibrated_mode(m, frequency_factor, damping_factor))
+        .zip(frequency_factors)
+        .map(|(m, &f)| recalibrated_mode(m, f, damping_factor))
         .collect::<Result<Vec<_>>>()?;
     let c = model.cutting();
     Ok(model

@@ -419,8 +419,15 @@ pub fn diagnosis_findings(page: &mut Page, d: &Diagnosis) {
         ),
         Verdict::Unexplained => format!(
             "Verdict: unexplained. None of the tried effects explains the gap: the best, {}{evidence}, \
-             still fails the posterior predictive check. Look for an effect outside the list.",
-            effect_words(d.best_class)
+             still fails the posterior predictive check{}. Look for an effect outside the list.",
+            effect_words(d.best_class),
+            d.predictive_check
+                .failing_band()
+                .map_or(String::new(), |(from, to)| format!(
+                    ", its misfit concentrated between {} and {} rpm",
+                    number(from),
+                    number(to)
+                ))
         ),
     });
     if let Some(r) = d

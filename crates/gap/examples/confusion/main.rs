@@ -9,8 +9,21 @@
 //! --classes drift --cases control,effects,outside --cuts 40 --samples 120 --steps 1 --sampler-offset 0
 //! --fit parameter_error,extra_mode --verbose]`; `--fit` limits the classes the diagnosis tries
 //! (all by default).
+//!
+//! `-- --public ../shared/data/gap_public [--only 05,11]` diagnoses instead the campaigns of an
+//! outside generator (`public_NN/` with `model.json`, `observations.json`, `heldout.json`,
+//! `answer.json`; read from there, never copied) with the diagnosis defaults and validation off,
+//! scores the verdict as that set's README does (`consistent` for `none`; for an effect outside
+//! the list `unexplained`, or `consistent` where the nominal model misclassifies at most 1 of
+//! the 40 held-out cuts) and computes the held-out closure (accuracy of the diagnosed model minus
+//! that of the nominal model over the nominal model's error, where it misses at least 2) with
+//! the diagnosed machine that `chatter diagnose` writes to `diagnosed_model.json` (with the
+//! speed softening and drift of `diagnosed_effects.json`), labelled stable where |mu| < 1 by the
+//! inference's solver.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod public;
 
 use chatter_gap::generator::{proving_machines, true_variant};
 use chatter_gap::predict::inference_solver;
@@ -61,6 +74,9 @@ impl Observer for Log {
 }
 
 fn main() -> chatter_gap::Result<()> {
+    if let Some(dir) = arg("--public") {
+        return public::run(std::path::Path::new(&dir), &Log(Instant::now()));
+    }
     let machines = proving_machines()?;
     let pick: Vec<usize> = list("--machines", (0..machines.len()).collect());
     let seeds: u64 = arg("--seeds").and_then(|s| s.parse().ok()).unwrap_or(1);
