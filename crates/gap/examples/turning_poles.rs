@@ -82,8 +82,10 @@
 //! 700 Hz chain), at -1.06 to +1.20 % (RMS 0.7 %, the generator's 1 % noise); today's nearest
 //! candidate is that same root in all 8. So the frequency misfit of today's likelihood on this
 //! campaign is not a missing candidate but the spread: `NoiseModel::pole_frequency_std_fraction`
-//! is 0.3 % of f_n, and these residuals give chi-square 45 on 8 poles (tail probability about
-//! 3e-7, the p ~ 1e-6).
+//! is 0.3 % of the reference frequency (1.35 Hz for 450 Hz, 2.1 Hz for 700 Hz), and these
+//! residuals give chi-square 47 (each pole's own mode as reference) to 87 (450 Hz for all) on
+//! 8 poles, tail probability 2e-7 to 2e-15 (consistent with the p ~ 1e-6, a mean over
+//! posterior samples).
 //!
 //! # Proposed pole prediction for turning
 //! Candidates: the rightmost root of each mode's chain (the characteristic root of largest real
