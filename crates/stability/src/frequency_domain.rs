@@ -167,6 +167,42 @@ pub fn dominant_and_unstable_poles(
     ))
 }
 
+/// Every distinct closed-loop pole (upper half plane) that the starts of [`dominant_pole`]
+/// reach, by decreasing real part, so the first is the dominant pole: near each mode the chain
+/// of delay roots spaced about 1 / tau in frequency, and the real root of slow surface
+/// regeneration. Roots closer than 1e-6 |lambda| are one. The chain is listed only within the
+/// grid's span (15 % around each mode and its cut-stiffness frequency); a root far down the
+/// chain that no start converges to is missing. An error only when no start converges.
+///
+/// ```
+/// use chatter_dynamics::examples;
+/// use chatter_stability::frequency_domain::{characteristic_roots, dominant_pole};
+/// let model = examples::ahmadi_2022_turning();
+/// let roots = characteristic_roots(&model, 3000.0, 1e-3).unwrap();
+/// let dominant = dominant_pole(&model, 3000.0, 1e-3).unwrap();
+/// assert!(roots.len() > 1);
+/// assert!((roots[0].lambda - dominant.lambda).norm() < 1e-6 * dominant.lambda.norm());
+/// assert!(roots.windows(2).all(|w| w[0].lambda.re >= w[1].lambda.re));
+/// ```
+pub fn characteristic_roots(
+    model: &ModalModel,
+    speed_rpm: f64,
+    width_m: f64,
+) -> Result<Vec<ClosedLoopPole>> {
+    let mut roots = grid_roots(model, speed_rpm, width_m)?;
+    if roots.is_empty() {
+        return Err(no_root(speed_rpm, width_m));
+    }
+    roots.sort_by(|a, b| b.re.total_cmp(&a.re));
+    let mut distinct: Vec<Complex64> = Vec::with_capacity(roots.len());
+    for r in roots {
+        if distinct.iter().all(|d| (d - r).norm() > 1e-6 * r.norm()) {
+            distinct.push(r);
+        }
+    }
+    Ok(distinct.into_iter().map(ClosedLoopPole::new).collect())
+}
+
 /// Where the branch of each of `poles` (closed-loop poles at `speed_rpm` and width `width_m`,
 /// e.g. the unstable ones of [`dominant_and_unstable_poles`]) crosses the imaginary axis as the
 /// width is lowered: the width (m) and the pole there, `None` for a pole that is not unstable
