@@ -164,7 +164,7 @@ pub fn diagnose_recordings(
         return Err(JobError::Invalid {
             field: "observations",
             value: format!(
-                "no cuts, no poles and none of the {} signal records judged",
+                "no cuts and no poles, and none of the {} signal records judged",
                 rows.len()
             ),
             expected: format!(
