@@ -554,7 +554,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         folder.path_of("shopfloor_model.json"),
         folder.path_of("shopfloor_observations.json"),
     );
-    let (diagnosis, report, files) = crate::diagnose::report_of(
+    let (recorded, report, files) = crate::diagnose::report_of(
         &nominal,
         &campaign,
         &crate::diagnose::DiagnoseRequest {
@@ -570,6 +570,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             quiet,
         },
     )?;
+    let diagnosis = recorded.diagnosis;
     folder.add("diagnosis/report.json", report);
     for (name, bytes) in files {
         folder.add(Path::new("diagnosis").join(name), bytes);

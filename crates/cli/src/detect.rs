@@ -1,5 +1,6 @@
 //! `chatter detect`: stable or chatter, and the chatter frequency, for every signal record of an
-//! observations file (`chatter_oma::detection`).
+//! observations file (`chatter_oma::detection`, called through `chatter_jobs::detect`, which
+//! `chatter diagnose` shares for recordings).
 //!
 //! Each record is read (CSV at the entry's `sample_rate_hz`, WAV or MP3 at its own rate); its
 //! `once_per_rev_channel`, if any, gives the spindle frequency and is left out of the spectrum,
@@ -33,8 +34,9 @@
 
 use crate::output::emit;
 use anyhow::{Context, Result, bail};
-use chatter_dynamics::{Cut, CutEvidence, ModalModel, Observations, Operation, SignalRecord};
-use chatter_oma::detection::{Detection, DetectionOptions, Verdict, detect};
+use chatter_dynamics::{ModalModel, Observations, Operation, SignalRecord};
+use chatter_jobs::detect::{DetectRequest, detect_record};
+use chatter_oma::detection::Detection;
 use chatter_oma::interference::Interference;
 use plotters::prelude::*;
 use std::path::PathBuf;
@@ -94,7 +96,10 @@ pub fn run(args: &DetectArgs) -> Result<()> {
             crate::output::Folder::new("--plot", dir, &known)
         })
         .transpose()?;
-    let interference = interference(&args.interference_hz)?;
+    let request = DetectRequest {
+        interference: interference(&args.interference_hz)?,
+        estimate_speed: args.estimate_speed,
+    };
     let mut cuts = observations.cuts.clone();
     for (i, record) in observations.signals.iter().enumerate() {
         let context = || {
@@ -104,27 +109,19 @@ pub fn run(args: &DetectArgs) -> Result<()> {
                 record.file.display()
             )
         };
-        let signals = chatter_jobs::oma::read_record(i, record).with_context(context)?;
-        if let Some(m) = &model {
-            chatter_jobs::oma::channels_match(m, &signals.names, &context())?;
-        }
-        let mut options = if args.estimate_speed {
-            DetectionOptions::unknown_speed()
-        } else {
-            DetectionOptions::new(record.speed_rpm / 60.0)
-        };
-        options.once_per_rev_channel = record.once_per_rev_channel.clone();
-        options.interference = interference.clone();
-        options.teeth = model.as_ref().and_then(|m| match m.operation() {
-            Operation::Milling(milling) => Some(milling.teeth()),
-            _ => None,
-        });
-        let detection = detect(&signals, &options).with_context(context)?;
+        let judged = detect_record(
+            i,
+            record,
+            model.as_ref(),
+            &request,
+            &chatter_progress::Silent,
+        )
+        .with_context(context)?;
         if let Some(folder) = &mut plots {
-            let svg = draw(record, model.as_ref(), &detection).with_context(context)?;
+            let svg = draw(record, model.as_ref(), &judged.detection).with_context(context)?;
             folder.add(format!("detect-{}.svg", i + 1), svg);
         }
-        cuts.push(cut(record, &detection, &interference, args.estimate_speed));
+        cuts.push(judged.cut);
     }
     if let Some(folder) = plots {
         for path in folder.commit()? {
@@ -156,114 +153,6 @@ pub(crate) fn interference(values: &[String]) -> Result<Interference> {
         })
         .collect::<Result<Vec<f64>>>()
         .map(Interference::Known)
-}
-
-fn cut(record: &SignalRecord, d: &Detection, interference: &Interference, estimated: bool) -> Cut {
-    let e = &d.evidence;
-    // the line that decided: the whole record's, the windows' or the flip line's when only
-    // they chatter
-    let windowed = e
-        .windows
-        .as_ref()
-        .and_then(|w| w.chatter.as_ref().zip(w.margin));
-    let flip = e.flip.as_ref().filter(|f| f.chatter);
-    let (line_hz, line_variation, margin) = match (windowed, flip) {
-        (Some((span, m)), _) if d.chatter_hz == Some(span.line_hz) => {
-            (span.line_hz, span.line_variation, m)
-        }
-        (_, Some(f)) if d.chatter_hz == Some(f.line_hz) => {
-            (f.line_hz, f.line_variation, f.variation_margin)
-        }
-        _ => (e.peak_hz, e.line_variation, e.margin),
-    };
-    let name = record.file.file_name().map_or_else(
-        || record.file.display().to_string(),
-        |n| n.to_string_lossy().into(),
-    );
-    let (speed_rpm, speed_note) = if estimated {
-        let rpm = 60.0 * e.fundamental_hz;
-        (
-            rpm,
-            format!(
-                "; speed estimated from the harmonic comb: {:.3} Hz ({rpm:.0} rpm)",
-                e.fundamental_hz
-            ),
-        )
-    } else {
-        (record.speed_rpm, String::new())
-    };
-    Cut {
-        speed_rpm,
-        depth_mm: record.depth_mm,
-        stable: d.verdict == Verdict::Stable,
-        chatter_hz: d.chatter_hz,
-        sequence: record.sequence,
-        radial_immersion: record.radial_immersion,
-        note: Some(format!(
-            "detect {name}{speed_note}{}{}{}",
-            chatter_jobs::oma::interference_note(interference, d),
-            windows_note(d),
-            flip_note(d)
-        )),
-        evidence: Some(CutEvidence {
-            fundamental_hz: e.fundamental_hz,
-            line_hz,
-            line_variation,
-            margin,
-            line_to_forced_db: e.line_to_forced_db,
-            line_to_floor_db: e.line_to_floor_db,
-            line_to_rest_db: e.line_to_rest_db,
-            resolution_hz: e.resolution_hz,
-        }),
-    }
-}
-
-/// The window-by-window judgement, for a note: the chattering span, or the best margin.
-fn windows_note(d: &Detection) -> String {
-    let Some(w) = &d.evidence.windows else {
-        return "; record shorter than 1.5 windows: judged whole".into();
-    };
-    let reference = if w.reference_stretch {
-        let quiet = w.windows.iter().filter(|j| j.reference).count();
-        format!(
-            ", {quiet} of them a reference stretch without the cut ({:.1} dB quieter), not judged",
-            w.contrast_db
-        )
-    } else {
-        String::new()
-    };
-    let frame = format!(
-        "{} windows of {:.2} s (chatter counts from {:.2} s){reference}",
-        w.windows.len(),
-        w.window_s,
-        w.min_duration_s
-    );
-    match (&w.chatter, w.margin) {
-        (Some(c), _) if c.by_dominance => format!(
-            "; {frame}: chatter at {:.1} Hz from {:.1} to {:.1} s, a line carrying over half \
-             of the cut's power (V {:.2})",
-            c.line_hz, c.start_s, c.end_s, c.line_variation
-        ),
-        (Some(c), Some(m)) => format!(
-            "; {frame}: chatter at {:.1} Hz from {:.1} to {:.1} s (V {:.2}, margin {m:+.3})",
-            c.line_hz, c.start_s, c.end_s, c.line_variation
-        ),
-        (_, Some(m)) => format!("; {frame}: no sustained chatter (margin {m:+.3})"),
-        _ => format!("; {frame}: no line standing out in two neighbouring windows"),
-    }
-}
-
-/// The flip lines (tooth count known from the model), for a note.
-fn flip_note(d: &Detection) -> String {
-    d.evidence.flip.as_ref().map_or(String::new(), |f| {
-        format!(
-            "; flip line {:.1} Hz: V {:.2}, {:.1} dB over the runout lines{}",
-            f.line_hz,
-            f.line_variation,
-            f.line_to_runout_db.unwrap_or(f64::NAN),
-            if f.chatter { ", flip chatter" } else { "" }
-        )
-    })
 }
 
 /// The spectrum (log scale) over the band, the harmonics as grey ticks, the line as a red

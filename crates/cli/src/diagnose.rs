@@ -1,12 +1,23 @@
 //! `chatter diagnose`: the sim-to-real gap between a model and shop-floor observations.
+//!
+//! An observations file with `signals` (a shop's recordings) is diagnosed from them:
+//! `chatter_jobs::diagnose::diagnose_recordings` judges each record by chatter detection and
+//! identifies the stable ones by OMA (the library calls of `chatter detect` and `chatter oma`,
+//! their default settings), and the diagnosis runs on those cuts and poles with the file's own.
+//! Each record's verdict, chatter frequency, identified pole, evidence, or the reason it gave no
+//! cut or pole, is the `records` table of the report JSON, of `diagnosis.json` and of the
+//! `--report` page.
 
 use crate::output::Folder;
 use crate::plot::{Markers, Series, line_chart_svg};
 use crate::{inputs, progress::Bar};
 use anyhow::{Context, Result, bail};
 use chatter_gap::{Diagnosis, EffectClass, Validation};
-use chatter_jobs::diagnose::{DiagnoseRequest as JobRequest, diagnose};
+use chatter_jobs::diagnose::{
+    DiagnoseRequest as JobRequest, RecordedDiagnosis, diagnose_recordings,
+};
 use chatter_jobs::inference_data::{Draws, InferenceData};
+use chatter_jobs::recordings::{RecordRow, RecordsRequest};
 use chatter_progress::Observer;
 use plotters::style::{BLUE, RED};
 use std::io::Write;
@@ -59,6 +70,9 @@ struct Report<'a> {
     /// Largest shift of any prediction by the best class, in noise standard deviations.
     practical_shift_std: f64,
     notes: &'a [String],
+    /// One row per signal record (absent without `signals`).
+    #[serde(skip_serializing_if = "<[RecordRow]>::is_empty")]
+    records: &'a [RecordRow],
 }
 
 /// Progress over the classes and the validation folds.
@@ -103,9 +117,9 @@ pub fn run(r: &DiagnoseRequest, folds_given: bool) -> Result<()> {
     }
     let model = inputs::model(r.model)?;
     let observations = inputs::observations(r.observations)?;
-    let (diagnosis, json, files) = report_of(&model, &observations, r)?;
+    let (recorded, json, files) = report_of(&model, &observations, r)?;
     if let Some(path) = r.report {
-        crate::report::jobs::diagnose(&model, &observations, &diagnosis, &files)?.write(path)?;
+        crate::report::jobs::diagnose(&model, &observations, &recorded, &files)?.write(path)?;
     }
     if let Some(mut folder) = folder {
         for (name, bytes) in files {
@@ -117,17 +131,29 @@ pub fn run(r: &DiagnoseRequest, folds_given: bool) -> Result<()> {
     writeln!(stdout, "{json}").context("writing to stdout")
 }
 
-/// The diagnosis, its report JSON and, with `out` or `report`, the files `diagnosis.json`,
-/// `diagnosed_model.json` (and `diagnosed_effects.json`), `lobes.svg` and `residuals.svg` (name
-/// and content; the caller writes them), of a model and observations already read (`r.model`
-/// and `r.observations` name them in messages).
+/// The diagnosis (with the table of the signal records it was made from), its report JSON and,
+/// with `out` or `report`, the files `diagnosis.json`, `diagnosed_model.json` (and
+/// `diagnosed_effects.json`), `lobes.svg` and `residuals.svg` (name and content; the caller
+/// writes them), of a model and observations already read (`r.model` and `r.observations` name
+/// them in messages).
 pub fn report_of(
     model: &chatter_dynamics::ModalModel,
     observations: &chatter_dynamics::Observations,
     r: &DiagnoseRequest,
-) -> Result<(Diagnosis, String, Files)> {
+) -> Result<(RecordedDiagnosis, String, Files)> {
     crate::validate::observations_match(model, observations, r.observations, r.model)?;
-    crate::validate::observation_work_size(model, observations, r.observations)?;
+    // the records' speeds too: their cuts and poles are evaluated like the file's own
+    let speeds: Vec<f64> = observations
+        .speeds_rpm()
+        .into_iter()
+        .chain(observations.signals.iter().map(|s| s.speed_rpm))
+        .collect();
+    crate::validate::work_size(
+        model,
+        chatter_stability::monodromy::Discretization::full(),
+        &speeds,
+        &format!("{} (observed speeds)", r.observations.display()),
+    )?;
     let validation = match r.validation {
         ValidationArg::Kfold => Validation::KFold { folds: r.folds },
         ValidationArg::SpeedBands => Validation::SpeedBands { bands: r.folds },
@@ -139,7 +165,17 @@ pub fn report_of(
         validation,
         pointwise: r.netcdf,
     };
-    chatter_jobs::diagnose::check(observations, &request).map_err(crate::job_error)?;
+    // before the work; with records, the folds are checked by the job against the cuts and
+    // poles made from them
+    let early = if observations.signals.is_empty() {
+        request
+    } else {
+        JobRequest {
+            validation: Validation::Off,
+            ..request
+        }
+    };
+    chatter_jobs::diagnose::check(observations, &early).map_err(crate::job_error)?;
     let folds = if validation == Validation::Off {
         0
     } else {
@@ -153,17 +189,29 @@ pub fn report_of(
         ),
         done: AtomicUsize::new(0),
     };
-    let diagnosis = diagnose(model, observations, &request, &progress)
-        .map_err(crate::job_error)
-        .with_context(|| {
-            format!(
-                "diagnosing {} against {}",
-                r.observations.display(),
-                r.model.display()
-            )
-        })?;
+    if !observations.signals.is_empty() {
+        progress.bar.announce(&format!(
+            "chatter detection and OMA of {} signal records first",
+            observations.signals.len()
+        ));
+    }
+    let recorded = diagnose_recordings(
+        model,
+        observations,
+        &request,
+        &RecordsRequest::default(),
+        &progress,
+    )
+    .map_err(crate::job_error)
+    .with_context(|| {
+        format!(
+            "diagnosing {} against {}",
+            r.observations.display(),
+            r.model.display()
+        )
+    })?;
     progress.bar.finish();
-    let d = &diagnosis;
+    let d = &recorded.diagnosis;
     let report = Report {
         verdict: d.verdict.name(),
         best_class: d.best_class,
@@ -177,10 +225,12 @@ pub fn report_of(
         nominal_check: &d.nominal_check,
         practical_shift_std: d.practical_shift,
         notes: &d.notes,
+        records: &recorded.records,
     };
     let mut files: Files = Vec::new();
     if r.out.is_some() || r.report.is_some() {
-        let full = serde_json::to_string_pretty(&diagnosis)?;
+        let diagnosis = &recorded.diagnosis;
+        let full = serde_json::to_string_pretty(&recorded)?;
         files.push(("diagnosis.json".into(), full.into_bytes()));
         files.push((
             "diagnosed_model.json".into(),
@@ -198,10 +248,10 @@ pub fn report_of(
                 serde_json::to_string_pretty(&effects)?.into_bytes(),
             ));
         }
-        files.push(("lobes.svg".into(), lobe_plot(&diagnosis)?.into_bytes()));
+        files.push(("lobes.svg".into(), lobe_plot(diagnosis)?.into_bytes()));
         files.push((
             "residuals.svg".into(),
-            residual_map(&diagnosis)?.into_bytes(),
+            residual_map(diagnosis)?.into_bytes(),
         ));
         if r.netcdf {
             for c in &diagnosis.classes {
@@ -229,7 +279,7 @@ pub fn report_of(
         }
     }
     let json = serde_json::to_string_pretty(&report)?;
-    Ok((diagnosis, json, files))
+    Ok((recorded, json, files))
 }
 
 /// Lobes of the nominal and the diagnosed model over the observed cuts.

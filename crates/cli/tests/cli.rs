@@ -483,7 +483,8 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
     );
 }
 
-/// Clear errors: observations without cuts or poles, and invalid options.
+/// Clear errors: observations without cuts or poles (a signal record that cannot be read is
+/// named with its reason), and invalid options.
 #[test]
 fn diagnose_rejects_bad_input() {
     let dir = tempfile::tempdir().unwrap();
@@ -501,7 +502,10 @@ fn diagnose_rejects_bad_input() {
             .arg(&obs),
     );
     assert!(
-        err.contains("signals_only.json") && err.contains("no cuts and no poles"),
+        err.contains("signals_only.json")
+            && err.contains("no cuts and no poles")
+            && err.contains("signals[0]")
+            && err.contains("s.csv"),
         "{err}"
     );
     let err = fail(

@@ -5,10 +5,13 @@
 //! write.
 //!
 //! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
-//! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]).
+//! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]), also from recordings.
 //! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
 //! - [`bands`]: lobes, Type B offsets (001), credibility bounds (000), Monte Carlo (004).
 //! - [`oma`]: operational modal analysis of every signal record of an observations file.
+//! - [`detect`]: chatter detection of a signal record, as a labelled cut with its evidence.
+//! - [`recordings`]: a shop's recordings to labelled cuts and identified poles, one row per
+//!   record.
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
 //! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
 
@@ -16,11 +19,13 @@
 
 pub mod bands;
 pub mod campaign;
+pub mod detect;
 pub mod diagnose;
 pub mod error;
 pub mod inference_data;
 pub mod oma;
 pub mod plan;
+pub mod recordings;
 pub mod update;
 
 pub use error::{JobError, Result};

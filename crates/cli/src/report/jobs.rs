@@ -9,6 +9,8 @@ use crate::plot::Series;
 use anyhow::Result;
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_gap::{Diagnosis, EffectClass, Verdict};
+use chatter_jobs::diagnose::RecordedDiagnosis;
+use chatter_jobs::recordings::{RecordVerdict, row_file_name};
 use chatter_updating::plan::PlanOutcome;
 use chatter_updating::update::UpdateResult;
 use std::collections::HashMap;
@@ -614,11 +616,12 @@ pub fn diagnosis_findings(page: &mut Page, d: &Diagnosis) {
     }
 }
 
-/// The page of `chatter diagnose`: `figures` are the lobe plot and the residual map.
+/// The page of `chatter diagnose`: `observations` as read, the diagnosis with the table of
+/// the signal records it was made from; `figures` are the lobe plot and the residual map.
 pub fn diagnose(
     model: &ModalModel,
     observations: &Observations,
-    d: &Diagnosis,
+    recorded: &RecordedDiagnosis,
     figures: &[(String, Vec<u8>)],
 ) -> Result<Page> {
     let mut page = common(
@@ -626,9 +629,83 @@ pub fn diagnose(
         model,
         Some(observations),
     );
-    diagnosis_findings(&mut page, d);
+    if !recorded.records.is_empty() {
+        page.input(
+            "observations diagnosed",
+            observation_counts(&recorded.observations),
+        );
+        records_findings(&mut page, recorded);
+    }
+    diagnosis_findings(&mut page, &recorded.diagnosis);
     add_svgs(&mut page, figures, "")?;
     Ok(page)
+}
+
+/// What the signal records gave, in words, a warning per record without a cut or a pole for a
+/// reason other than chatter, and the `records` table: detection's verdict, chatter frequency
+/// and evidence, the identified pole, or the reason there is none.
+fn records_findings(page: &mut Page, recorded: &RecordedDiagnosis) {
+    let c = recorded.record_counts();
+    page.verdict(format!(
+        "The diagnosis is made from {} signal records: chatter detection judged {} stable and \
+         {} chatter ({} not judged); OMA identified a pole from {} of the {} stable records. \
+         See the table of signal records.",
+        recorded.records.len(),
+        c.stable,
+        c.chatter,
+        c.not_judged,
+        c.poles,
+        c.stable
+    ));
+    for r in &recorded.records {
+        if r.verdict != RecordVerdict::Chatter
+            && let Some(reason) = &r.reason
+        {
+            page.warning(format!(
+                "signals[{}] ({}): {reason}",
+                r.record,
+                row_file_name(r)
+            ));
+        }
+    }
+    let mut t = Table::new(
+        "Signal records: chatter detection and OMA",
+        &[
+            "record",
+            "file",
+            "speed (rpm)",
+            "depth (mm)",
+            "verdict",
+            "chatter frequency (Hz)",
+            "pole frequency (Hz)",
+            "pole damping ratio",
+            "line (Hz)",
+            "line variation V",
+            "margin (positive: chatter)",
+            "line over floor (dB)",
+            "reason (no cut or no pole)",
+        ],
+    );
+    for r in &recorded.records {
+        let e = r.evidence.as_ref();
+        let p = r.pole.as_ref();
+        t.row(vec![
+            format!("signals[{}]", r.record),
+            row_file_name(r),
+            number(r.speed_rpm),
+            number(r.depth_mm),
+            r.verdict.name().into(),
+            optional(r.chatter_hz),
+            optional(p.map(|p| p.frequency_hz)),
+            optional(p.map(|p| p.damping_ratio)),
+            optional(e.map(|e| e.line_hz)),
+            optional(e.map(|e| e.line_variation)),
+            optional(e.map(|e| e.margin)),
+            optional(e.map(|e| e.line_to_floor_db)),
+            r.reason.clone().unwrap_or_default(),
+        ]);
+    }
+    page.table(t);
 }
 
 /// Caption of a plot file the commands write.
