@@ -19,6 +19,7 @@ pub mod monodromy;
 pub mod multiplier;
 pub mod prepared;
 pub mod process_damping;
+pub mod recommend;
 pub mod resonance;
 mod root;
 pub mod sensitivity;
