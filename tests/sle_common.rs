@@ -5,6 +5,7 @@ use chatter_dynamics::simulate::simulate;
 use chatter_dynamics::sle::surface_location_error;
 use chatter_dynamics::{MillingDirection, ModalModel, Operation, examples};
 
+#[allow(dead_code)]
 #[path = "transient.rs"]
 mod transient;
 use transient::deterministic;

@@ -21,6 +21,7 @@ mod progress;
 mod rcsa;
 mod report;
 mod sensitivity;
+mod shop;
 mod update;
 mod validate;
 
@@ -117,6 +118,62 @@ enum Command {
         /// Depths of the |mu| map MIN:MAX:N (mm); default 80 depths up to 1.5x the deepest limit.
         #[arg(long)]
         depths: Option<String>,
+    },
+    /// Surface location error of stable milling cuts over speeds (Schmitz & Mann 2006): CSV
+    /// speed_rpm,sle_um,peak_to_valley_um,modulus,stable (> 0 undercut, < 0 overcut).
+    Sle {
+        /// Model file (milling, even pitch).
+        #[arg(long)]
+        model: PathBuf,
+        /// Speeds MIN:MAX:N (rpm).
+        #[arg(long)]
+        speeds: String,
+        /// Axial depth of cut (mm).
+        #[arg(long)]
+        depth_mm: f64,
+        /// Feed per tooth (mm); default 0.05.
+        #[arg(long, default_value_t = 0.05)]
+        feed_per_tooth_mm: f64,
+        /// Write the CSV here instead of stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// SVG plot of the SLE over the stable speeds.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// The highest-MRR stable cut (FDM lobes, limit derated for a risk) within a depth limit
+    /// and an SLE tolerance, and the Harmonizer's speeds for a chattering cut, as JSON.
+    Recommend {
+        /// Model file (milling).
+        #[arg(long)]
+        model: PathBuf,
+        /// Deepest cut the tool or machine takes (mm).
+        #[arg(long)]
+        max_depth_mm: f64,
+        /// Largest surface location error allowed (um).
+        #[arg(long)]
+        sle_tolerance_um: Option<f64>,
+        /// Accepted probability of chatter; default 0.05.
+        #[arg(long)]
+        risk: Option<f64>,
+        /// Assumed standard deviation of the limiting depth (% of the nominal); default 10.
+        #[arg(long)]
+        limit_sd_percent: Option<f64>,
+        /// Feed per tooth (mm) of the SLE and MRR; default 0.05.
+        #[arg(long, default_value_t = 0.05)]
+        feed_per_tooth_mm: f64,
+        /// Speeds MIN:MAX:N (rpm) to choose from; default those of `lobes`.
+        #[arg(long)]
+        speeds: Option<String>,
+        /// Speed (rpm) of a cut that chattered.
+        #[arg(long)]
+        chatter_speed_rpm: Option<f64>,
+        /// Its chatter frequency (Hz).
+        #[arg(long)]
+        chatter_hz: Option<f64>,
+        /// Write the JSON here instead of stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Dominant Floquet multiplier at one cut, as JSON.
     Multiplier {
@@ -377,6 +434,43 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             },
             quiet,
         ),
+        Command::Sle {
+            model,
+            speeds,
+            depth_mm,
+            feed_per_tooth_mm,
+            out,
+            plot,
+        } => shop::sle(&shop::SleRequest {
+            model: &model,
+            speeds: &speeds,
+            depth_mm,
+            feed_per_tooth_mm,
+            out: out.as_deref(),
+            plot: plot.as_deref(),
+        }),
+        Command::Recommend {
+            model,
+            max_depth_mm,
+            sle_tolerance_um,
+            risk,
+            limit_sd_percent,
+            feed_per_tooth_mm,
+            speeds,
+            chatter_speed_rpm,
+            chatter_hz,
+            out,
+        } => shop::recommend(&shop::RecommendRequest {
+            model: &model,
+            max_depth_mm,
+            sle_tolerance_um,
+            risk,
+            limit_sd_percent,
+            feed_per_tooth_mm,
+            speeds: speeds.as_deref(),
+            chatter: (chatter_speed_rpm, chatter_hz),
+            out: out.as_deref(),
+        }),
         Command::Multiplier {
             model,
             speed_rpm,

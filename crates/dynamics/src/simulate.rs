@@ -12,7 +12,8 @@
 //! # Surface memory and loss of contact
 //! The edge position along n is e(t) = n . (x(t) + feed(t)), with feed(t) the rigid feed motion
 //! (f_z per delay). The chip is h = e(t) - S(t - tau), where S is the surface the previous edge
-//! left at the same angle. When h > 0 the edge cuts, the force is b h u and S(t) = e(t); when
+//! left at the same angle (one pitch ago, pitch_j / Omega, on a variable-pitch cutter; the surface
+//! is kept per angle of the revolution). When h > 0 the edge cuts, the force is b h u and S(t) = e(t); when
 //! h <= 0 the edge is out of contact, the force is zero and the older surface remains,
 //! S(t) = S(t - tau). Before the first pass the surface is the nominal one of a rigid tool.
 //!
@@ -34,8 +35,10 @@
 //! first step of an edge in the cut, where the previous step has no chip, the end values are
 //! those on the surface the previous edge cut there one delay ago, with x(t_{k+1}) ~ x + v h.
 //! The switching is located inside the step instead of on the grid:
-//! - entry and exit: the angle of tooth j at step k is 2 pi ((k + j steps_per_delay) mod R) / R
-//!   with R the steps per revolution, so the part [a, z] of the step the tooth spends between
+//! - entry and exit: the angle of tooth j at step k is 2 pi ((k + o_j) mod R) / R with R the
+//!   steps per revolution and o_j the tooth's offset in steps (j steps_per_delay for even pitch;
+//!   for a variable-pitch cutter, `operation.pitch_deg`, the steps per delay are raised until
+//!   every offset is whole, [`PITCH_GRID_SEARCH`]), so the part [a, z] of the step the tooth spends between
 //!   the entry and exit angles of [`crate::Milling::entry_exit_rad`] is known exactly
 //!   (a = clamp(entry / dphi - m, 0, 1), z = clamp(exit / dphi - m, 0, 1), m the angle in steps,
 //!   dphi = 2 pi / R); a tooth that enters inside the step has no chip at t_k (the surface
@@ -368,7 +371,7 @@ pub fn simulate_with_observer(
         Operation::Turning(_) => None,
         Operation::Milling(m) => Some(m.entry_exit_rad()),
     };
-    // tooth angles: tooth j at step k is at 2 pi ((k + j steps_per_delay) mod R) / R, with R the
+    // tooth angles: tooth j at step k is at 2 pi ((k + offset_steps[j]) mod R) / R, with R the
     // steps per revolution (a whole number: the delay is a whole number of steps)
     let steps_per_rev = steps_per_delay * edges;
     let step_angle = 2.0 * PI / steps_per_rev as f64;
@@ -379,7 +382,7 @@ pub fn simulate_with_observer(
         Some((entry, exit)) => (entry / step_angle, exit / step_angle),
         None => (0.0, 0.0),
     };
-    // each tooth's angle in steps, (k + j steps_per_delay) mod steps_per_rev
+    // each tooth's angle in steps, (k + offset_steps[j]) mod steps_per_rev
     let mut tooth_index = vec![0usize; edges];
     // (sin, cos) of each tooth angle, rotated by the step angle and recomputed every delay
     let mut tooth_sc = vec![[0.0f64, 1.0f64]; edges];
