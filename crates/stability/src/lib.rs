@@ -24,6 +24,7 @@ pub mod resonance;
 mod root;
 pub mod sensitivity;
 pub mod speed_grid;
+pub mod ssv;
 mod step;
 pub mod zero_order;
 

@@ -375,8 +375,14 @@ impl StepPlan {
         };
         let constant = matches!(model.operation(), Operation::Turning(_));
         if model.operation().is_variable_pitch() {
-            let segments =
-                variable_pitch_segments(&periodic, &segs, (m_cut, cutting_time), &a0, method)?;
+            let segments = variable_pitch_segments(
+                &periodic,
+                &segs,
+                (m_cut, cutting_time),
+                &a0,
+                method,
+                None,
+            )?;
             return Ok(Self {
                 modes: n,
                 scheme: method.scheme,
@@ -698,6 +704,146 @@ impl StepPlan {
     }
 }
 
+/// Tooth angles under a sinusoidal spindle-speed variation, Omega(t) = Omega_0 (1 + A sin(w_m t))
+/// (Insperger & Stépán 2004; Sastry, Kapoor & DeVor 2002): the angle is Omega_0 s(t) with the
+/// equivalent constant-speed time s(t) = t - (A / w_m) (cos(w_m t) - 1), increasing for A < 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TimeMap {
+    pub(crate) amplitude: f64,
+    pub(crate) omega_m: f64,
+}
+
+impl TimeMap {
+    /// s(t).
+    pub(crate) fn equivalent(&self, t: f64) -> f64 {
+        t - self.amplitude / self.omega_m * ((self.omega_m * t).cos() - 1.0)
+    }
+
+    /// The t with s(t) = `s` (Newton from t = s; s' = 1 + A sin(w_m t) >= 1 - A > 0).
+    pub(crate) fn inverse(&self, s: f64) -> f64 {
+        let mut t = s;
+        for _ in 0..100 {
+            let step = (self.equivalent(t) - s) / (1.0 + self.amplitude * (self.omega_m * t).sin());
+            t -= step;
+            if step.abs() <= 1e-15 * (1.0 + t.abs()) {
+                break;
+            }
+        }
+        t
+    }
+}
+
+impl StepPlan {
+    /// The plan of `method` for `model` at the mean speed `speed_rpm` under the spindle-speed
+    /// variation of relative amplitude `amplitude_ratio` in (0, 1) at `frequency_ratio` times the
+    /// mean spindle frequency: the principal period is the modulation period T_m, which must hold
+    /// a whole number q = N / frequency_ratio of mean tooth periods (of revolutions in turning),
+    /// the grid is cut at every tooth entry and exit in true time, and each step's delayed points
+    /// are where the tooth ahead passed the same angle (the time-varying delay, interpolated in
+    /// the history). Models with process damping are refused (the cutting speed varies too).
+    pub(crate) fn with_speed_variation(
+        model: &ModalModel,
+        speed_rpm: f64,
+        method: Discretization,
+        (amplitude_ratio, frequency_ratio): (f64, f64),
+    ) -> Result<Self> {
+        check_condition(speed_rpm, 0.0)?;
+        model.require_proportional(method.scheme.name())?;
+        if model.process_damping_n_per_m().is_some_and(|c| c > 0.0) {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: "process_damping with a spindle-speed variation (the cutting speed varies \
+                         along the cut) is not modelled"
+                    .into(),
+            });
+        }
+        let op = model.operation();
+        let delays = op.delays_per_revolution();
+        let q_real = delays as f64 / frequency_ratio;
+        let q = q_real.round();
+        if !(q >= 1.0 && (q_real - q).abs() <= 1e-9 * q_real) {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: format!(
+                    "ssv_frequency_ratio = {frequency_ratio}: the modulation period must hold a \
+                     whole number of tooth periods (revolutions in turning), i.e. a ratio \
+                     {delays} / q for an integer q >= 1 (here {delays} / {frequency_ratio} = {q_real})"
+                ),
+            });
+        }
+        let q = q as usize;
+        let tau = op.delay_s(speed_rpm);
+        let period = q as f64 * tau;
+        let revolution = 60.0 / speed_rpm;
+        let omega = 2.0 * std::f64::consts::PI / revolution;
+        let map = TimeMap {
+            amplitude: amplitude_ratio,
+            omega_m: 2.0 * std::f64::consts::PI / period,
+        };
+        // breakpoints in equivalent time: every entry and exit over the q delays
+        let mut cuts = vec![0.0, period];
+        if let Operation::Milling(m) = op {
+            let (entry, exit) = m.entry_exit_rad();
+            let revolutions = (period / revolution).ceil() as usize + 1;
+            for k in 0..revolutions {
+                for j in 0..m.teeth() {
+                    for angle in [entry, exit] {
+                        let s = ((angle - m.tooth_offset_rad(j)) / omega).rem_euclid(revolution)
+                            + k as f64 * revolution;
+                        if s > 1e-12 * period && s < period * (1.0 - 1e-12) {
+                            cuts.push(s);
+                        }
+                    }
+                }
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * period);
+        let segs: Vec<(f64, f64, bool)> = cuts
+            .windows(2)
+            .map(|w| {
+                let mid = 0.5 * (w[0] + w[1]);
+                let cutting = model.directional_matrix(mid, speed_rpm).abs().max() > 0.0;
+                (map.inverse(w[0]), map.inverse(w[1]), cutting)
+            })
+            .collect();
+        let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
+        let m_cut = method.cutting_steps(model, cutting_time / q as f64).get() * q;
+        let n = model.mode_count();
+        let d = 2 * n;
+        let omegas = model.omegas_rad_s();
+        let zetas = model.damping_ratios();
+        let mut a0 = DMatrix::zeros(d, d);
+        for i in 0..n {
+            a0[(i, n + i)] = 1.0;
+            a0[(n + i, i)] = -omegas[i] * omegas[i];
+            a0[(n + i, n + i)] = -2.0 * zetas[i] * omegas[i];
+        }
+        let periodic = Periodic {
+            model,
+            speed_rpm,
+            phi: row_major(&model.shape_matrix()),
+            modes: n,
+        };
+        let segments = variable_pitch_segments(
+            &periodic,
+            &segs,
+            (m_cut, cutting_time),
+            &a0,
+            method,
+            Some(map),
+        )?;
+        Ok(Self {
+            modes: n,
+            scheme: method.scheme,
+            a0,
+            segments,
+            constant: false,
+            period_s: period,
+        })
+    }
+}
+
 /// The segments of a variable-pitch cutter over one revolution `period` (grid `segs` cut at every
 /// tooth's entry and exit): free flight as for even pitch; cutting segments with
 /// `m_cut` steps over the `cutting_time` in proportion to their length, the total [W | P] and
@@ -705,19 +851,24 @@ impl StepPlan {
 /// points t_k - tau_t, t_{k+1} - tau_t located in the history (linear interpolation between grid
 /// points; on the grid itself when the teeth's cuts do not overlap, since every tooth's cut then
 /// gets the same steps).
+///
+/// With a spindle-speed variation (`map`, [`TimeMap`]) the segments are in true time, the
+/// coefficients are sampled at the equivalent constant-speed time of the tooth angles, and each
+/// tooth's delay is the time the spindle takes to turn its pitch before the step's points.
 fn variable_pitch_segments(
     periodic: &Periodic,
     segs: &[(f64, f64, bool)],
     (m_cut, cutting_time): (usize, f64),
     a0: &DMatrix<f64>,
     method: Discretization,
+    map: Option<TimeMap>,
 ) -> Result<Vec<Segment>> {
-    let Operation::Milling(milling) = periodic.model.operation() else {
-        return Err(StabilityError::Unsupported {
-            method: method.scheme.name(),
-            reason: "variable pitch is a milling cutter's".into(),
-        });
+    let operation = periodic.model.operation();
+    let pitch = |j: usize| match operation {
+        Operation::Milling(m) => m.tooth_pitch_rad(j),
+        Operation::Turning(_) => 2.0 * std::f64::consts::PI,
     };
+    let equivalent = |t: f64| map.map_or(t, |m| m.equivalent(t));
     let omega = 2.0 * std::f64::consts::PI * periodic.speed_rpm / 60.0;
     let period = segs.last().map_or(0.0, |s| s.1);
     // steps per segment and the grid times
@@ -742,6 +893,15 @@ fn variable_pitch_segments(
     let grid = times.len() - 1;
     let locate = |u: f64, step: usize| -> Result<Interp> {
         // u in [0, 2 T): the previous period's grid, then this one's
+        if u < -1e-12 * period {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: format!(
+                    "a delay longer than the principal period ({period} s): the history holds \
+                     one period"
+                ),
+            });
+        }
         let (base, v) = if u >= period {
             (grid, u - period)
         } else {
@@ -804,11 +964,11 @@ fn variable_pitch_segments(
         };
         let mut unit = Vec::new();
         for &t in &samples {
-            periodic.push(t, &mut unit);
+            periodic.push(equivalent(t), &mut unit);
         }
-        let mid = 0.5 * (start + end);
+        let mid = equivalent(0.5 * (start + end));
         let mut teeth = Vec::new();
-        for j in 0..milling.teeth() {
+        for j in 0..operation.delays_per_revolution() {
             if periodic
                 .model
                 .tooth_directional_matrix(j, mid, periodic.speed_rpm)
@@ -820,17 +980,24 @@ fn variable_pitch_segments(
             }
             let mut tooth_unit = Vec::new();
             for &t in &samples {
-                periodic.push_tooth(j, t, &mut tooth_unit);
+                periodic.push_tooth(j, equivalent(t), &mut tooth_unit);
             }
-            let tau = milling.tooth_pitch_rad(j) / omega;
+            let tau = pitch(j) / omega;
             let taps = (0..k)
                 .map(|i| {
                     let t0 = start + i as f64 * h;
                     let step = first_step + i;
-                    Ok((
-                        locate(t0 - tau + period, step)?,
-                        locate(t0 + h - tau + period, step)?,
-                    ))
+                    Ok(match map {
+                        None => (
+                            locate(t0 - tau + period, step)?,
+                            locate(t0 + h - tau + period, step)?,
+                        ),
+                        // the time the tooth ahead passed the same angle
+                        Some(m) => (
+                            locate(m.inverse(m.equivalent(t0) - tau) + period, step)?,
+                            locate(m.inverse(m.equivalent(t0 + h) - tau) + period, step)?,
+                        ),
+                    })
                 })
                 .collect::<Result<Vec<_>>>()?;
             teeth.push(ToothInput {
