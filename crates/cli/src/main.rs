@@ -189,6 +189,15 @@ enum Command {
         /// fdm or sdm.
         #[arg(long, value_enum, default_value = "fdm")]
         method: Method,
+        /// Spindle-speed variation: amplitude ratio A in [0, 1) of a sinusoidal speed
+        /// Omega_0 (1 + A sin(2 pi r f_0 t)); needs --ssv-frequency-ratio. The multiplier is then
+        /// over the modulation period.
+        #[arg(long)]
+        ssv_amplitude_ratio: Option<f64>,
+        /// Spindle-speed variation: frequency ratio r (modulation over spindle frequency), such
+        /// that the modulation period holds a whole number of tooth periods (N / r an integer).
+        #[arg(long)]
+        ssv_frequency_ratio: Option<f64>,
     },
     /// Uncertainty bands around the lobes: CSV speed_rpm,depth_mm,lower_mm,upper_mm,...
     Bands {
@@ -476,6 +485,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             speed_rpm,
             depth_mm,
             method,
+            ssv_amplitude_ratio,
+            ssv_frequency_ratio,
         } => commands::multiplier(
             &model,
             validate::option(
@@ -485,6 +496,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             )?,
             validate::option("--depth-mm", depth_mm, &chatter_dynamics::limits::DEPTH_MM)?,
             method,
+            shop::speed_variation(ssv_amplitude_ratio, ssv_frequency_ratio)?,
             quiet,
         ),
         Command::Bands {

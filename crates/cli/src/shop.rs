@@ -175,3 +175,24 @@ pub fn recommend(r: &RecommendRequest) -> Result<()> {
     });
     emit(r.out, &(serde_json::to_string_pretty(&json)? + "\n"))
 }
+
+/// `--ssv-amplitude-ratio` and `--ssv-frequency-ratio`: both or neither.
+pub fn speed_variation(
+    amplitude: Option<f64>,
+    frequency: Option<f64>,
+) -> Result<Option<chatter_stability::ssv::SpeedVariation>> {
+    match (amplitude, frequency) {
+        (None, None) => Ok(None),
+        (Some(a), Some(r)) => chatter_stability::ssv::SpeedVariation::new(a, r)
+            .map(Some)
+            .map_err(|e| {
+                anyhow::anyhow!(
+                    "--ssv-amplitude-ratio {} --ssv-frequency-ratio {}: {e}",
+                    validate::as_typed("--ssv-amplitude-ratio", a),
+                    validate::as_typed("--ssv-frequency-ratio", r)
+                )
+            }),
+        (Some(_), None) => bail!("--ssv-amplitude-ratio needs --ssv-frequency-ratio"),
+        (None, Some(_)) => bail!("--ssv-frequency-ratio needs --ssv-amplitude-ratio"),
+    }
+}

@@ -179,3 +179,39 @@ fn variable_pitch_model_file() {
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("operation.pitch_deg"), "{err}");
 }
+
+/// `multiplier` with a spindle-speed variation: the multiplier over the modulation period; at
+/// zero amplitude the constant-speed one; an amplitude of 1 is refused by name.
+#[test]
+fn multiplier_with_speed_variation() {
+    let model = example("ahmadi2022_turning_model.json");
+    let m = model.to_str().unwrap();
+    let base = [
+        "multiplier",
+        "--model",
+        m,
+        "--speed-rpm",
+        "7000",
+        "--depth-mm",
+        "3",
+    ];
+    let (code, plain, err) = run(&base);
+    assert_eq!(code, Some(0), "{err}");
+    let plain: serde_json::Value = serde_json::from_str(&plain).unwrap();
+    let with = |a: &str| {
+        let mut args = base.to_vec();
+        args.extend(["--ssv-amplitude-ratio", a, "--ssv-frequency-ratio", "0.2"]);
+        run(&args)
+    };
+    let (code, zero, err) = with("0");
+    assert_eq!(code, Some(0), "{err}");
+    let zero: serde_json::Value = serde_json::from_str(&zero).unwrap();
+    assert_eq!(zero["modulus"], plain["modulus"]);
+    let (code, varied, err) = with("0.1");
+    assert_eq!(code, Some(0), "{err}");
+    let varied: serde_json::Value = serde_json::from_str(&varied).unwrap();
+    assert!(varied["period_s"].as_f64().unwrap() > 4.9 * 60.0 / 7000.0);
+    let (code, _, err) = with("1");
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("ssv_amplitude_ratio"), "{err}");
+}
