@@ -302,11 +302,12 @@ pub fn harmonic_speeds(
                 harmonic: k,
                 reason: format!(
                     "at {speed_rpm:.0} rpm harmonic {k} of the tooth-passing frequency \
-                     ({teeth} teeth x {:.2} Hz) equals the chatter frequency {chatter_hz:.1} Hz \
-                     heard at {chatter_speed_rpm:.0} rpm ({:+.1} % speed); the spindle then \
-                     drives the mode that chattered in phase with the regeneration, the top of a \
-                     stability lobe",
+                     ({teeth} teeth x {:.2} rev/s = {:.1} Hz) equals the chatter frequency \
+                     {chatter_hz:.1} Hz heard at {chatter_speed_rpm:.0} rpm ({:+.1} % speed): \
+                     each tooth then meets the wave the previous one left in phase, so the chip \
+                     thickness hardly varies, the speed of a stability pocket",
                     speed_rpm / 60.0,
+                    speed_rpm / 60.0 * teeth as f64,
                     (speed_rpm / chatter_speed_rpm - 1.0) * 100.0
                 ),
             }
