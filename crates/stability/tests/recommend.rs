@@ -23,6 +23,8 @@ fn proposes_the_11300_rpm_pocket() {
     assert!((r.speed_rpm / 11_300.0 - 1.0).abs() < 0.03, "{r:?}");
     assert!(r.depth_mm < r.limiting_depth_mm);
     assert_eq!(r.limited_by, "stability");
+    // the default derating: 1 - z(0.95) x 10 %
+    assert!((r.derated_depth_mm / r.limiting_depth_mm - (1.0 - 0.164_485_362_7)).abs() < 1e-9);
     // with a wall tolerance of a tenth of the unconstrained cut's SLE the depth is lowered
     let free = highest_mrr_cut(
         &model,
