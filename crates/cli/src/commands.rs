@@ -346,12 +346,35 @@ pub fn multiplier(
     speed_rpm: f64,
     depth_mm: f64,
     method: Method,
+    variation: Option<chatter_stability::ssv::SpeedVariation>,
     quiet: bool,
 ) -> Result<()> {
     let model = inputs::model(model_path)?;
     let Some(solver) = method.discretization() else {
         bail!("--method zoa gives limiting depths, not multipliers; use fdm or sdm");
     };
+    if let Some(variation) = variation {
+        validate::work_size(&model, solver, &[speed_rpm], "--speed-rpm")?;
+        let varied = chatter_stability::ssv::VariedSpeed {
+            discretization: solver,
+            variation,
+        };
+        let mu = varied.dominant_multiplier(&model, speed_rpm, depth_mm * 1e-3)?;
+        let json = serde_json::json!({
+            "speed_rpm": speed_rpm,
+            "depth_mm": depth_mm,
+            "method": solver.name(),
+            "ssv_amplitude_ratio": variation.amplitude_ratio(),
+            "ssv_frequency_ratio": variation.frequency_ratio(),
+            "period_s": mu.period_s,
+            "modulus": mu.modulus(),
+            "real": mu.value.re,
+            "imag": mu.value.im,
+            "stable": mu.modulus() < 1.0,
+        });
+        println!("{}", serde_json::to_string_pretty(&json)?);
+        return Ok(());
+    }
     validate::work_size(&model, solver, &[speed_rpm], "--speed-rpm")?;
     let steps = solver.steps_at(&model, speed_rpm);
     let working = Working::start(

@@ -21,6 +21,7 @@ mod progress;
 mod rcsa;
 mod report;
 mod sensitivity;
+mod shop;
 mod update;
 mod validate;
 
@@ -118,6 +119,62 @@ enum Command {
         #[arg(long)]
         depths: Option<String>,
     },
+    /// Surface location error of stable milling cuts over speeds (Schmitz & Mann 2006): CSV
+    /// speed_rpm,sle_um,peak_to_valley_um,modulus,stable (> 0 undercut, < 0 overcut).
+    Sle {
+        /// Model file (milling, even pitch).
+        #[arg(long)]
+        model: PathBuf,
+        /// Speeds MIN:MAX:N (rpm).
+        #[arg(long)]
+        speeds: String,
+        /// Axial depth of cut (mm).
+        #[arg(long)]
+        depth_mm: f64,
+        /// Feed per tooth (mm); default 0.05.
+        #[arg(long, default_value_t = 0.05)]
+        feed_per_tooth_mm: f64,
+        /// Write the CSV here instead of stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// SVG plot of the SLE over the stable speeds.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// The highest-MRR stable cut (FDM lobes, limit derated for a risk) within a depth limit
+    /// and an SLE tolerance, and the Harmonizer's speeds for a chattering cut, as JSON.
+    Recommend {
+        /// Model file (milling).
+        #[arg(long)]
+        model: PathBuf,
+        /// Deepest cut the tool or machine takes (mm).
+        #[arg(long)]
+        max_depth_mm: f64,
+        /// Largest surface location error allowed (um).
+        #[arg(long)]
+        sle_tolerance_um: Option<f64>,
+        /// Accepted probability of chatter; default 0.05.
+        #[arg(long)]
+        risk: Option<f64>,
+        /// Assumed standard deviation of the limiting depth (% of the nominal); default 10.
+        #[arg(long)]
+        limit_sd_percent: Option<f64>,
+        /// Feed per tooth (mm) of the SLE and MRR; default 0.05.
+        #[arg(long, default_value_t = 0.05)]
+        feed_per_tooth_mm: f64,
+        /// Speeds MIN:MAX:N (rpm) to choose from; default those of `lobes`.
+        #[arg(long)]
+        speeds: Option<String>,
+        /// Speed (rpm) of a cut that chattered.
+        #[arg(long)]
+        chatter_speed_rpm: Option<f64>,
+        /// Its chatter frequency (Hz).
+        #[arg(long)]
+        chatter_hz: Option<f64>,
+        /// Write the JSON here instead of stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Dominant Floquet multiplier at one cut, as JSON.
     Multiplier {
         /// Model file.
@@ -132,6 +189,15 @@ enum Command {
         /// fdm or sdm.
         #[arg(long, value_enum, default_value = "fdm")]
         method: Method,
+        /// Spindle-speed variation: amplitude ratio A in [0, 1) of a sinusoidal speed
+        /// Omega_0 (1 + A sin(2 pi r f_0 t)); needs --ssv-frequency-ratio. The multiplier is then
+        /// over the modulation period.
+        #[arg(long)]
+        ssv_amplitude_ratio: Option<f64>,
+        /// Spindle-speed variation: frequency ratio r (modulation over spindle frequency), such
+        /// that the modulation period holds a whole number of tooth periods (N / r an integer).
+        #[arg(long)]
+        ssv_frequency_ratio: Option<f64>,
     },
     /// Uncertainty bands around the lobes: CSV speed_rpm,depth_mm,lower_mm,upper_mm,...
     Bands {
@@ -377,11 +443,50 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             },
             quiet,
         ),
+        Command::Sle {
+            model,
+            speeds,
+            depth_mm,
+            feed_per_tooth_mm,
+            out,
+            plot,
+        } => shop::sle(&shop::SleRequest {
+            model: &model,
+            speeds: &speeds,
+            depth_mm,
+            feed_per_tooth_mm,
+            out: out.as_deref(),
+            plot: plot.as_deref(),
+        }),
+        Command::Recommend {
+            model,
+            max_depth_mm,
+            sle_tolerance_um,
+            risk,
+            limit_sd_percent,
+            feed_per_tooth_mm,
+            speeds,
+            chatter_speed_rpm,
+            chatter_hz,
+            out,
+        } => shop::recommend(&shop::RecommendRequest {
+            model: &model,
+            max_depth_mm,
+            sle_tolerance_um,
+            risk,
+            limit_sd_percent,
+            feed_per_tooth_mm,
+            speeds: speeds.as_deref(),
+            chatter: (chatter_speed_rpm, chatter_hz),
+            out: out.as_deref(),
+        }),
         Command::Multiplier {
             model,
             speed_rpm,
             depth_mm,
             method,
+            ssv_amplitude_ratio,
+            ssv_frequency_ratio,
         } => commands::multiplier(
             &model,
             validate::option(
@@ -391,6 +496,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             )?,
             validate::option("--depth-mm", depth_mm, &chatter_dynamics::limits::DEPTH_MM)?,
             method,
+            shop::speed_variation(ssv_amplitude_ratio, ssv_frequency_ratio)?,
             quiet,
         ),
         Command::Bands {

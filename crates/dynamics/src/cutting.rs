@@ -53,10 +53,29 @@ impl ModalModel {
                 let omega = 2.0 * PI * speed_rpm / 60.0;
                 let n = m.teeth();
                 (0..n)
-                    .map(|j| omega * t_s + 2.0 * PI * j as f64 / n as f64)
+                    .map(|j| omega * t_s + m.tooth_offset_rad(j))
                     .filter(|&phi| tooth_in_cut(m, phi))
                     .map(|phi| milling_tooth_matrix(cutting, phi))
                     .sum()
+            }
+        }
+    }
+
+    /// Tooth j's part of H(t) (N/m^2): its directional matrix while it cuts, else zero (tooth j
+    /// at phi_j = Omega t + offset_j, [`Milling::tooth_offset_rad`]); its force acts on the
+    /// displacement difference over its own delay, pitch_j / Omega. Turning has one edge (j = 0),
+    /// K_c. The sum over j is [`Self::directional_matrix`].
+    pub fn tooth_directional_matrix(&self, tooth: usize, t_s: f64, speed_rpm: f64) -> Matrix2<f64> {
+        let cutting = self.cutting();
+        match self.operation() {
+            Operation::Turning(_) => turning_matrix(cutting),
+            Operation::Milling(m) => {
+                let phi = 2.0 * PI * speed_rpm / 60.0 * t_s + m.tooth_offset_rad(tooth);
+                if tooth_in_cut(m, phi) {
+                    milling_tooth_matrix(cutting, phi)
+                } else {
+                    Matrix2::zeros()
+                }
             }
         }
     }
@@ -92,7 +111,7 @@ impl ModalModel {
                 let omega = 2.0 * PI * speed_rpm / 60.0;
                 let n = m.teeth();
                 (0..n)
-                    .map(|j| omega * t_s + 2.0 * PI * j as f64 / n as f64)
+                    .map(|j| omega * t_s + m.tooth_offset_rad(j))
                     .filter(|&phi| tooth_in_cut(m, phi))
                     .map(|phi| {
                         let d = milling_chip_direction(phi);

@@ -39,6 +39,7 @@ pub mod perturbation;
 mod resample;
 pub mod sampled;
 pub mod simulate;
+pub mod sle;
 
 pub use chatter_modal::{ModalPole, pole};
 pub use error::{DynamicsError, Result};

@@ -119,6 +119,11 @@ pub struct OperationFile {
     /// Milling: helix angle (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub helix_deg: Option<f64>,
+    /// Milling, variable pitch (optional): the angle (deg) from each tooth to the tooth ahead of
+    /// it, one per tooth, each > 0, summing to 360 ([`crate::Milling::with_pitch_deg`]);
+    /// absent: even pitch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_deg: Option<Vec<f64>>,
     /// Turning: workpiece diameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub workpiece_diameter_mm: Option<f64>,
@@ -249,13 +254,16 @@ impl OperationFile {
                 };
                 let d = opt_f("operation.tool_diameter_mm", self.tool_diameter_mm)?;
                 let h = opt_f("operation.helix_deg", self.helix_deg)?;
-                Ok(Operation::Milling(Milling::new(
-                    teeth as usize,
-                    r,
-                    direction,
-                    d.map(|d| d * 1e-3),
-                    h.map(f64::to_radians),
-                )?))
+                Ok(Operation::Milling(
+                    Milling::new(
+                        teeth as usize,
+                        r,
+                        direction,
+                        d.map(|d| d * 1e-3),
+                        h.map(f64::to_radians),
+                    )?
+                    .with_pitch_deg(self.pitch_deg.as_deref())?,
+                ))
             }
             "turning" => {
                 for (set, name) in [
@@ -264,6 +272,7 @@ impl OperationFile {
                     (self.direction.is_some(), "direction"),
                     (self.tool_diameter_mm.is_some(), "tool_diameter_mm"),
                     (self.helix_deg.is_some(), "helix_deg"),
+                    (self.pitch_deg.is_some(), "pitch_deg"),
                 ] {
                     if set {
                         return Err(DynamicsError::invalid(
@@ -531,6 +540,7 @@ impl ModelFile {
                 ),
                 tool_diameter_mm: m.tool_diameter_m().map(|d| d * 1e3),
                 helix_deg: m.helix_rad().map(f64::to_degrees),
+                pitch_deg: m.pitch_deg(),
                 workpiece_diameter_mm: None,
             },
             Operation::Turning(t) => OperationFile {
@@ -540,6 +550,7 @@ impl ModelFile {
                 direction: None,
                 tool_diameter_mm: None,
                 helix_deg: None,
+                pitch_deg: None,
                 workpiece_diameter_mm: t.workpiece_diameter_m().map(|d| d * 1e3),
             },
         };

@@ -41,7 +41,15 @@ pub enum MillingDirection {
     Down,
 }
 
-/// Milling geometry: teeth, radial immersion, direction, diameter.
+/// Milling geometry: teeth, radial immersion, direction, diameter and, for a variable-pitch
+/// cutter, the pitch angles.
+///
+/// # Pitch
+/// Tooth j sits at the angle offset_j = sum_{i < j} pitch_i ahead of tooth 0 (phi_j(t) =
+/// Omega t + offset_j), so the tooth that passes an angle just before tooth j is tooth j + 1
+/// (mod N) and tooth j cuts the surface it left `pitch_j` earlier: tooth j's regenerative delay
+/// is tau_j = pitch_j / Omega (Altintas, Engin & Budak 1999). With even pitch (the default,
+/// `pitch_deg` absent) every pitch is 2 pi / N and offset_j = 2 pi j / N exactly as before.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Milling {
     teeth: usize,
@@ -49,7 +57,13 @@ pub struct Milling {
     direction: MillingDirection,
     tool_diameter_m: Option<f64>,
     helix_rad: Option<f64>,
+    /// Pitch angles (rad) as given, one per tooth, summing to 2 pi; `None`: even pitch.
+    pitch_rad: Option<Vec<f64>>,
 }
+
+/// Largest difference (deg) between the sum of `pitch_deg` and 360 that is accepted (rounding
+/// in a file written to a few decimals); pitches within it of 360 / N count as even pitch.
+pub const PITCH_SUM_TOLERANCE_DEG: f64 = 1e-6;
 
 impl Milling {
     /// Validated milling geometry. `radial_immersion` is a/D in (0, 1].
@@ -92,7 +106,103 @@ impl Milling {
             direction,
             tool_diameter_m,
             helix_rad,
+            pitch_rad: None,
         })
+    }
+
+    /// The same cutter with the pitch angles `pitch_deg` (degrees, one per tooth, each > 0,
+    /// summing to 360 within [`PITCH_SUM_TOLERANCE_DEG`]); `None` is even pitch. Errors name
+    /// `operation.pitch_deg` and echo the values.
+    pub fn with_pitch_deg(self, pitch_deg: Option<&[f64]>) -> Result<Self> {
+        let Some(p) = pitch_deg else {
+            return Ok(Self {
+                pitch_rad: None,
+                ..self
+            });
+        };
+        let written = format!(
+            "[{}]",
+            p.iter()
+                .map(|v| crate::limits::written(*v))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if p.len() != self.teeth {
+            return Err(DynamicsError::invalid(
+                "operation.pitch_deg",
+                format!(
+                    "{written} has {} angles: expected one per tooth ({})",
+                    p.len(),
+                    self.teeth
+                ),
+            ));
+        }
+        if let Some((j, v)) = p
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+        {
+            return Err(DynamicsError::invalid(
+                format!("operation.pitch_deg[{j}]"),
+                format!(
+                    "{} in {written}: expected an angle > 0 degrees",
+                    crate::limits::written(*v)
+                ),
+            ));
+        }
+        let sum: f64 = p.iter().sum();
+        if (sum - 360.0).abs() > PITCH_SUM_TOLERANCE_DEG {
+            return Err(DynamicsError::invalid(
+                "operation.pitch_deg",
+                format!(
+                    "{written} sums to {} degrees: expected the angles between neighbouring \
+                     teeth around the cutter, summing to 360",
+                    crate::limits::written(sum)
+                ),
+            ));
+        }
+        Ok(Self {
+            pitch_rad: Some(p.iter().map(|v| v.to_radians()).collect()),
+            ..self
+        })
+    }
+
+    /// The pitch angles in degrees as given (`None`: even pitch, the default).
+    pub fn pitch_deg(&self) -> Option<Vec<f64>> {
+        self.pitch_rad
+            .as_ref()
+            .map(|p| p.iter().map(|v| v.to_degrees()).collect())
+    }
+
+    /// Whether the pitch is uneven: pitch angles given and one of them more than
+    /// [`PITCH_SUM_TOLERANCE_DEG`] from 360 / N. An even `pitch_deg` ([90, 90, 90, 90]) is the
+    /// default cutter, to the bit.
+    pub fn is_variable_pitch(&self) -> bool {
+        let even = 2.0 * PI / self.teeth as f64;
+        self.pitch_rad.as_ref().is_some_and(|p| {
+            p.iter()
+                .any(|v| (v - even).abs() > PITCH_SUM_TOLERANCE_DEG.to_radians())
+        })
+    }
+
+    /// The angle (rad) by which tooth j leads tooth 0: 2 pi j / N for even pitch, the sum of the
+    /// pitches of teeth 0..j otherwise (struct docs). `j` is taken modulo N.
+    pub fn tooth_offset_rad(&self, j: usize) -> f64 {
+        let j = j % self.teeth;
+        match &self.pitch_rad {
+            Some(p) if self.is_variable_pitch() => p[..j].iter().sum(),
+            _ => 2.0 * PI * j as f64 / self.teeth as f64,
+        }
+    }
+
+    /// Tooth j's pitch (rad): the angle from it to the tooth ahead of it, which cut the surface
+    /// tooth j cuts (`j` modulo N); 2 pi / N for even pitch.
+    pub fn tooth_pitch_rad(&self, j: usize) -> f64 {
+        let j = j % self.teeth;
+        match &self.pitch_rad {
+            Some(p) if self.is_variable_pitch() => p[j],
+            _ => 2.0 * PI / self.teeth as f64,
+        }
     }
 
     /// Number of teeth.
@@ -118,13 +228,16 @@ impl Milling {
 
     /// The same geometry at another radial immersion (observations may override it per cut).
     pub fn with_radial_immersion(&self, radial_immersion: f64) -> Result<Self> {
-        Self::new(
-            self.teeth,
-            radial_immersion,
-            self.direction,
-            self.tool_diameter_m,
-            self.helix_rad,
-        )
+        Ok(Self {
+            pitch_rad: self.pitch_rad.clone(),
+            ..Self::new(
+                self.teeth,
+                radial_immersion,
+                self.direction,
+                self.tool_diameter_m,
+                self.helix_rad,
+            )?
+        })
     }
 
     /// Entry and exit angles (rad) of a tooth, measured from the y axis in the direction of
@@ -192,9 +305,26 @@ impl Operation {
         }
     }
 
-    /// The regenerative delay tau (s) at a spindle speed in rpm.
+    /// The regenerative delay tau (s) at a spindle speed in rpm: the tooth period (the mean one
+    /// of a variable-pitch cutter) in milling, the revolution in turning.
     pub fn delay_s(&self, speed_rpm: f64) -> f64 {
         60.0 / (speed_rpm * self.delays_per_revolution() as f64)
+    }
+
+    /// Whether this is a variable-pitch milling cutter ([`Milling::is_variable_pitch`]).
+    pub fn is_variable_pitch(&self) -> bool {
+        matches!(self, Operation::Milling(m) if m.is_variable_pitch())
+    }
+
+    /// The principal period (s) of the cutting force at `speed_rpm`: the delay
+    /// ([`Self::delay_s`]), except for a variable-pitch cutter, whose force repeats once per
+    /// spindle revolution (60 / n) and whose multipliers are over that period.
+    pub fn principal_period_s(&self, speed_rpm: f64) -> f64 {
+        if self.is_variable_pitch() {
+            60.0 / speed_rpm
+        } else {
+            self.delay_s(speed_rpm)
+        }
     }
 
     /// Diameter (m) that sets the cutting speed V = pi D n, when given.

@@ -12,7 +12,8 @@
 //! # Surface memory and loss of contact
 //! The edge position along n is e(t) = n . (x(t) + feed(t)), with feed(t) the rigid feed motion
 //! (f_z per delay). The chip is h = e(t) - S(t - tau), where S is the surface the previous edge
-//! left at the same angle. When h > 0 the edge cuts, the force is b h u and S(t) = e(t); when
+//! left at the same angle (one pitch ago, pitch_j / Omega, on a variable-pitch cutter; the surface
+//! is kept per angle of the revolution). When h > 0 the edge cuts, the force is b h u and S(t) = e(t); when
 //! h <= 0 the edge is out of contact, the force is zero and the older surface remains,
 //! S(t) = S(t - tau). Before the first pass the surface is the nominal one of a rigid tool.
 //!
@@ -34,8 +35,10 @@
 //! first step of an edge in the cut, where the previous step has no chip, the end values are
 //! those on the surface the previous edge cut there one delay ago, with x(t_{k+1}) ~ x + v h.
 //! The switching is located inside the step instead of on the grid:
-//! - entry and exit: the angle of tooth j at step k is 2 pi ((k + j steps_per_delay) mod R) / R
-//!   with R the steps per revolution, so the part [a, z] of the step the tooth spends between
+//! - entry and exit: the angle of tooth j at step k is 2 pi ((k + o_j) mod R) / R with R the
+//!   steps per revolution and o_j the tooth's offset in steps (j steps_per_delay for even pitch;
+//!   for a variable-pitch cutter, `operation.pitch_deg`, the steps per delay are raised until
+//!   every offset is whole, [`PITCH_GRID_SEARCH`]), so the part [a, z] of the step the tooth spends between
 //!   the entry and exit angles of [`crate::Milling::entry_exit_rad`] is known exactly
 //!   (a = clamp(entry / dphi - m, 0, 1), z = clamp(exit / dphi - m, 0, 1), m the angle in steps,
 //!   dphi = 2 pi / R); a tooth that enters inside the step has no chip at t_k (the surface
@@ -198,6 +201,11 @@ pub const MIN_STEPS_PER_DELAY: usize = 50;
 /// Most surface samples (internal steps per delay times cutting edges) the simulator keeps: the
 /// surface of the previous pass is a ring buffer of this length (8 bytes each, 400 MB at most).
 pub const MAX_SURFACE_SAMPLES: usize = 50_000_000;
+/// How many more steps per delay than the dynamics ask for a variable-pitch cutter may get so
+/// that every tooth offset is a whole number of steps (then the surface each tooth cuts lies on
+/// the grid, one pitch back, without interpolation); beyond it the offsets are rounded to the
+/// nearest step (an error of at most half a step in each pitch).
+pub const PITCH_GRID_SEARCH: usize = 1000;
 
 /// Per mode: transition (row-major 2x2), input vector of the held force, input vector of the
 /// force's change over the step, shape, omega_n, zeta_n.
@@ -268,10 +276,46 @@ pub fn simulate_with_observer(
         Operation::Turning(_) => MIN_STEPS_PER_DELAY,
         Operation::Milling(_) => MIN_STEPS_PER_TOOTH,
     };
-    let (h, steps_per_delay) = internal_step(f_max, tau, min_steps);
+    let (mut h, mut steps_per_delay) = internal_step(f_max, tau, min_steps);
     let edges = match model.operation() {
         Operation::Turning(_) => 1,
         Operation::Milling(m) => m.teeth(),
+    };
+    // each tooth's angular offset in steps (tooth j at step k is at angle index
+    // (k + offset_j) mod R): j steps_per_delay for even pitch; for a variable-pitch cutter the
+    // steps per delay are raised (by at most PITCH_GRID_SEARCH) until every offset is a whole
+    // number of steps, else the offsets are rounded to the nearest step
+    let mut offset_steps: Vec<usize> = (0..edges).map(|j| j * steps_per_delay).collect();
+    if let Operation::Milling(m) = model.operation()
+        && m.is_variable_pitch()
+    {
+        let fractions: Vec<f64> = (0..edges)
+            .map(|j| m.tooth_offset_rad(j) / (2.0 * PI))
+            .collect();
+        let misfit = |spd: usize| {
+            let r = (spd * edges) as f64;
+            fractions
+                .iter()
+                .map(|f| (f * r - (f * r).round()).abs())
+                .fold(0.0, f64::max)
+        };
+        let spd = (steps_per_delay..steps_per_delay + PITCH_GRID_SEARCH)
+            .find(|&spd| misfit(spd) < 1e-6)
+            .unwrap_or(steps_per_delay);
+        steps_per_delay = spd;
+        h = tau / spd as f64;
+        let r = spd * edges;
+        offset_steps = fractions
+            .iter()
+            .map(|f| ((f * r as f64).round() as usize) % r)
+            .collect();
+    }
+    // the static chip of each edge in units of the feed per tooth: its pitch over the mean pitch
+    let chip_scale: Vec<f64> = match model.operation() {
+        Operation::Milling(m) if m.is_variable_pitch() => (0..edges)
+            .map(|j| m.tooth_pitch_rad(j) * edges as f64 / (2.0 * PI))
+            .collect(),
+        _ => vec![1.0; edges],
     };
     let surface_samples = steps_per_delay.saturating_mul(edges);
     if surface_samples > MAX_SURFACE_SAMPLES {
@@ -327,7 +371,7 @@ pub fn simulate_with_observer(
         Operation::Turning(_) => None,
         Operation::Milling(m) => Some(m.entry_exit_rad()),
     };
-    // tooth angles: tooth j at step k is at 2 pi ((k + j steps_per_delay) mod R) / R, with R the
+    // tooth angles: tooth j at step k is at 2 pi ((k + offset_steps[j]) mod R) / R, with R the
     // steps per revolution (a whole number: the delay is a whole number of steps)
     let steps_per_rev = steps_per_delay * edges;
     let step_angle = 2.0 * PI / steps_per_rev as f64;
@@ -338,7 +382,7 @@ pub fn simulate_with_observer(
         Some((entry, exit)) => (entry / step_angle, exit / step_angle),
         None => (0.0, 0.0),
     };
-    // each tooth's angle in steps, (k + j steps_per_delay) mod steps_per_rev
+    // each tooth's angle in steps, (k + offset_steps[j]) mod steps_per_rev
     let mut tooth_index = vec![0usize; edges];
     // (sin, cos) of each tooth angle, rotated by the step angle and recomputed every delay
     let mut tooth_sc = vec![[0.0f64, 1.0f64]; edges];
@@ -348,9 +392,12 @@ pub fn simulate_with_observer(
     let feed_speed = settings.feed_per_tooth_m / tau; // m/s along x (milling) or feed (turning)
     let b = settings.depth_m;
     let cv = model.process_damping_per_width(settings.speed_rpm);
-    // surface ring buffer: one value per edge per step over one delay
+    // surface ring buffer: the surface last left at each angle index of one revolution (steps
+    // per delay times edges values; in turning the revolution is the delay)
     let mut surface = vec![f64::NAN; steps_per_delay * edges];
-    // the slot's surfaces as they were one delay ago, read before any edge overwrites them
+    // each edge's angle index at this step, and the surface there as the edge ahead left it,
+    // read before any edge overwrites it
+    let mut angle_index = vec![0usize; edges];
     let mut previous_slot = vec![f64::NAN; edges];
     // per edge, the chip and the ungated force of the previous step (for the extrapolation)
     let mut previous_chip = vec![0.0f64; edges];
@@ -389,11 +436,10 @@ pub fn simulate_with_observer(
         let slot = step % steps_per_delay;
         let has_previous_step = step > 0;
         let after_first_delay = step >= steps_per_delay;
-        previous_slot.copy_from_slice(&surface[slot * edges..(slot + 1) * edges]);
         if milling.is_some() {
             if step % steps_per_delay == 0 {
                 for (j, (sc, index)) in tooth_sc.iter_mut().zip(&mut tooth_index).enumerate() {
-                    *index = (step + j * steps_per_delay) % steps_per_rev;
+                    *index = (step + offset_steps[j]) % steps_per_rev;
                     let (s, c) = (*index as f64 * step_angle).sin_cos();
                     *sc = [s, c];
                 }
@@ -407,6 +453,12 @@ pub fn simulate_with_observer(
                     };
                 }
             }
+            angle_index.copy_from_slice(&tooth_index);
+        } else {
+            angle_index[0] = slot;
+        }
+        for (previous, &index) in previous_slot.iter_mut().zip(&angle_index) {
+            *previous = surface[index];
         }
         for j in 0..edges {
             // chip direction n, force direction u and the part [a, z] of the step in the cut
@@ -428,12 +480,11 @@ pub fn simulate_with_observer(
             };
             // edge position along n including the rigid feed motion
             let e = n_dir[0] * (feed_speed * t - x[0]) - n_dir[1] * x[1];
-            // the surface at this angle was left one delay ago by the next edge (milling) or the
-            // same edge (turning)
-            let prev_edge = (j + 1) % edges;
-            let previous = previous_slot[prev_edge];
+            // the surface at this angle was left one pitch ago by the next edge (milling) or one
+            // revolution ago by the same edge (turning)
+            let previous = previous_slot[j];
             let s_prev = if previous.is_nan() {
-                e - settings.feed_per_tooth_m * n_dir[0] // rigid first pass
+                e - settings.feed_per_tooth_m * chip_scale[j] * n_dir[0] // rigid first pass
             } else {
                 previous
             };
@@ -469,9 +520,9 @@ pub fn simulate_with_observer(
                     };
                     let x_end = [x[0] + v[0] * h, x[1] + v[1] * h];
                     let e_end = n_end[0] * (feed_speed * (t + h) - x_end[0]) - n_end[1] * x_end[1];
-                    let s_next = surface[((slot + 1) % steps_per_delay) * edges + prev_edge];
+                    let s_next = surface[(angle_index[j] + 1) % steps_per_rev];
                     let chip_end = if s_next.is_nan() {
-                        settings.feed_per_tooth_m * n_end[0]
+                        settings.feed_per_tooth_m * chip_scale[j] * n_end[0]
                     } else {
                         e_end - s_next
                     };
@@ -547,7 +598,7 @@ pub fn simulate_with_observer(
                     new_surface = s_prev.min(e);
                 }
             }
-            surface[slot * edges + j] = new_surface;
+            surface[angle_index[j]] = new_surface;
         }
         if settings.harmonic_force_n > 0.0 {
             // known in closed form: its values at both ends of the step

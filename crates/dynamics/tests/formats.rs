@@ -300,3 +300,44 @@ proptest! {
         }
     }
 }
+
+/// `operation.pitch_deg`: absent is even pitch; a list must have one positive angle per tooth
+/// summing to 360, and errors name the field and echo the values.
+#[test]
+fn pitch_deg_is_checked_by_name() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/schmitz2023_milling_model.json"
+    ))
+    .unwrap();
+    let with = |pitch: &str| {
+        text.replacen(
+            "\"kind\": \"milling\"",
+            &format!("\"kind\": \"milling\", \"pitch_deg\": {pitch}"),
+            1,
+        )
+    };
+    let origin = std::path::Path::new("model.json");
+    let parse = |t: &str| chatter_dynamics::ModalModel::from_json_str(t, origin);
+    assert!(
+        with("[]").contains("pitch_deg"),
+        "the example's milling kind"
+    );
+    let ok = parse(&with("[70, 110, 70, 110]")).unwrap();
+    assert!(ok.operation().is_variable_pitch());
+    let round_trip = chatter_dynamics::model_file::ModelFile::from_model(&ok);
+    assert_eq!(
+        round_trip.operation.pitch_deg.as_deref().map(|p| p.len()),
+        Some(4)
+    );
+    for (pitch, expected) in [
+        ("[70, 110, 70, 100]", "sums to 350"),
+        ("[70, 110, 180]", "one per tooth (4)"),
+        ("[-70, 110, 210, 110]", "pitch_deg[0]"),
+        ("[0, 110, 140, 110]", "> 0"),
+    ] {
+        let err = parse(&with(pitch)).err().unwrap().to_string();
+        assert!(err.contains("operation.pitch_deg"), "{pitch}: {err}");
+        assert!(err.contains(expected), "{pitch}: {err}");
+    }
+}

@@ -131,3 +131,29 @@ fn milling_unstable_and_seeded() {
     let pulses = a.channels[2].data.iter().filter(|v| **v > 0.5).count();
     assert!((58..=59).contains(&pulses), "{pulses}");
 }
+
+/// An explicit even pitch (`pitch_deg` [90, 90, 90, 90]) simulates exactly as the default cutter,
+/// and a variable pitch runs (70-110-70-110: the steps per delay are raised until every tooth
+/// offset is a whole number of steps) with a different record.
+#[test]
+fn explicit_even_pitch_simulates_to_the_bit() {
+    use chatter_dynamics::Operation;
+    let base = chatter_dynamics::examples::schmitz_2023_milling();
+    let with = |p: &[f64]| {
+        let Operation::Milling(m) = base.operation() else {
+            unreachable!()
+        };
+        base.with_operation(Operation::Milling(
+            m.clone().with_pitch_deg(Some(p)).unwrap(),
+        ))
+        .unwrap()
+    };
+    let settings = chatter_dynamics::simulate::SimulationSettings::new(9000.0, 1e-3, 0.02, 1e4, 7);
+    let a = chatter_dynamics::simulate::simulate(&base, &settings).unwrap();
+    let b = chatter_dynamics::simulate::simulate(&with(&[90.0; 4]), &settings).unwrap();
+    assert_eq!(a, b);
+    let c = chatter_dynamics::simulate::simulate(&with(&[70.0, 110.0, 70.0, 110.0]), &settings)
+        .unwrap();
+    assert_ne!(a.channels[0].data, c.channels[0].data);
+    assert!(c.channels[0].data.iter().all(|v| v.is_finite()));
+}

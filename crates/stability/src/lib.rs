@@ -19,10 +19,12 @@ pub mod monodromy;
 pub mod multiplier;
 pub mod prepared;
 pub mod process_damping;
+pub mod recommend;
 pub mod resonance;
 mod root;
 pub mod sensitivity;
 pub mod speed_grid;
+pub mod ssv;
 mod step;
 pub mod zero_order;
 

@@ -105,6 +105,19 @@ pub const AUTO_MIN_STEPS: NonZeroUsize = steps::<40>();
 /// limiting depth is within 2 % of the converged one over the speed range (see the tests).
 pub const AUTO_STEPS_PER_CYCLE: f64 = 24.0;
 
+/// The principal period (s) of `model` at `speed_rpm` and the number of (mean) delays in it: the
+/// delay and 1, or for a variable-pitch cutter the revolution and the number of teeth (the step
+/// count of a [`Discretization`] is per delay, so the revolution gets that many times as many).
+pub(crate) fn principal_period(model: &ModalModel, speed_rpm: f64) -> (f64, usize) {
+    let op = model.operation();
+    let period = op.principal_period_s(speed_rpm);
+    if op.is_variable_pitch() {
+        (period, op.delays_per_revolution())
+    } else {
+        (period, 1)
+    }
+}
+
 /// A discretization solver: scheme plus resolution.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Discretization {
@@ -147,13 +160,13 @@ impl Discretization {
     /// The cutting steps per delay of this solver on `model` at `speed_rpm`: the fixed count,
     /// or the one [`StepsPerDelay::Auto`] picks there.
     pub fn steps_at(&self, model: &ModalModel, speed_rpm: f64) -> NonZeroUsize {
-        let tau = model.operation().delay_s(speed_rpm);
-        let cutting_time: f64 = segments(model, speed_rpm, tau)
+        let (period, delays) = principal_period(model, speed_rpm);
+        let cutting_time: f64 = segments(model, speed_rpm, period)
             .iter()
             .filter(|s| s.2)
             .map(|s| s.1 - s.0)
             .sum();
-        self.cutting_steps(model, cutting_time)
+        self.cutting_steps(model, cutting_time / delays as f64)
     }
 
     /// Cutting steps per delay for a delay that cuts during `cutting_time` seconds.
@@ -266,6 +279,29 @@ pub(crate) struct Step {
     /// end point is `start + 1` (or y_0 when it equals the grid size).
     pub(crate) start: usize,
     pub(crate) cutting: bool,
+    /// Variable pitch: the step's delayed inputs, `Monodromy::taps[taps.0..taps.1]` (one per
+    /// tooth in the cut); empty for one delay (R and S then follow P).
+    pub(crate) taps: (usize, usize),
+}
+
+/// A point of the displacement history by linear interpolation: (1 - w) q_p + w q_{p+1}, with
+/// p indexing the grid points of the previous period (0..M, from the input state) followed by
+/// those of the current one (M.., already computed by the sweep).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Interp {
+    pub(crate) p: usize,
+    pub(crate) w: f64,
+}
+
+/// One delayed input of a variable-pitch step: R (2N x N at `r`) times the history at `a` (the
+/// step's start minus the tooth's delay) plus S (at `s`) times the history at `b` (its end minus
+/// the delay).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Tap {
+    pub(crate) r: usize,
+    pub(crate) s: usize,
+    pub(crate) a: Interp,
+    pub(crate) b: Interp,
 }
 
 /// The discretized monodromy operator over one delay.
@@ -281,7 +317,9 @@ pub struct Monodromy {
     coefficients: Vec<f64>,
     /// Length (s) of the step leaving each grid point.
     step_s: Vec<f64>,
-    /// The delay tau (s).
+    /// The delayed inputs of variable-pitch steps (empty with one delay).
+    taps: Vec<Tap>,
+    /// The principal period (s): the delay tau, or the revolution of a variable-pitch cutter.
     pub period_s: f64,
 }
 
@@ -305,6 +343,7 @@ impl Monodromy {
         steps: Vec<Step>,
         coefficients: Vec<f64>,
         step_s: Vec<f64>,
+        taps: Vec<Tap>,
         period_s: f64,
     ) -> Self {
         Self {
@@ -313,6 +352,7 @@ impl Monodromy {
             steps,
             coefficients,
             step_s,
+            taps,
             period_s,
         }
     }
@@ -337,6 +377,9 @@ impl Monodromy {
 
     /// Apply the monodromy: `out` = U `x` (both of [`Self::dimension`]).
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        if !self.taps.is_empty() {
+            return self.sweep_taps(x, out);
+        }
         // literal state sizes let the compiler unroll the small block products of `sweep`
         match 2 * self.modes {
             2 => self.sweep(2, x, out),
@@ -399,6 +442,9 @@ impl Monodromy {
     /// [`Self::apply`] (each step y' = P y + R q_a + S q_b read backwards). Used for left
     /// eigenvectors without forming U.
     pub fn apply_transpose(&self, x: &[f64], out: &mut [f64]) {
+        if !self.taps.is_empty() {
+            return self.transpose_taps(x, out);
+        }
         let n = self.modes;
         let s2 = 2 * n;
         out.fill(0.0);
@@ -433,6 +479,118 @@ impl Monodromy {
             // the displacement at the step's start was stored as a delayed value
             for (pj, xj) in prev.iter_mut().zip(&x[a..a + n]) {
                 *pj += xj;
+            }
+            std::mem::swap(&mut ybar, &mut prev);
+        }
+        for (o, yi) in out.iter_mut().zip(&ybar) {
+            *o += yi;
+        }
+    }
+
+    /// The history value at `at` into `buf` (N): grid points before M from the input `x` (the
+    /// previous period), from M on from `out` (this period, written by the sweep).
+    fn interpolate(&self, at: Interp, x: &[f64], out: &[f64], buf: &mut [f64]) {
+        let n = self.modes;
+        let (s2, m) = (2 * n, self.grid);
+        let value = |p: usize| {
+            if p < m {
+                &x[s2 + p * n..s2 + (p + 1) * n]
+            } else {
+                &out[s2 + (p - m) * n..s2 + (p - m + 1) * n]
+            }
+        };
+        buf.copy_from_slice(value(at.p));
+        if at.w != 0.0 {
+            for (b, v) in buf.iter_mut().zip(value(at.p + 1)) {
+                *b = (1.0 - at.w) * *b + at.w * v;
+            }
+        }
+    }
+
+    /// [`Self::apply`] of a variable-pitch program: each step y' = P y + sum over its taps of
+    /// R q(t_k - tau_j) + S q(t_{k+1} - tau_j), the delayed displacements interpolated from the
+    /// previous period's history (input) or this period's (already swept).
+    fn sweep_taps(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.modes;
+        let s2 = 2 * n;
+        let mut y = x[..s2].to_vec();
+        let mut next = vec![0.0; s2];
+        let (mut qa, mut qb) = (vec![0.0; n], vec![0.0; n]);
+        for step in &self.steps {
+            let a = s2 + step.start * n;
+            out[a..a + n].copy_from_slice(&y[..n]);
+            let p = &self.coefficients[step.offset..step.offset + s2 * s2];
+            for (nx, row) in next.iter_mut().zip(p.chunks_exact(s2)) {
+                *nx = row.iter().zip(y.iter()).map(|(pij, yj)| pij * yj).sum();
+            }
+            for tap in &self.taps[step.taps.0..step.taps.1] {
+                self.interpolate(tap.a, x, out, &mut qa);
+                self.interpolate(tap.b, x, out, &mut qb);
+                let r = &self.coefficients[tap.r..tap.r + s2 * n];
+                let s = &self.coefficients[tap.s..tap.s + s2 * n];
+                for ((nx, ri), si) in next
+                    .iter_mut()
+                    .zip(r.chunks_exact(n))
+                    .zip(s.chunks_exact(n))
+                {
+                    for j in 0..n {
+                        *nx += ri[j] * qa[j] + si[j] * qb[j];
+                    }
+                }
+            }
+            std::mem::swap(&mut y, &mut next);
+        }
+        out[..s2].copy_from_slice(&y);
+    }
+
+    /// [`Self::apply_transpose`] of a variable-pitch program: the reverse sweep of
+    /// [`Self::sweep_taps`], the adjoints of this period's history gathered as the steps that
+    /// read them are undone (each is read only by steps at or after the point's own).
+    fn transpose_taps(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.modes;
+        let (s2, m) = (2 * n, self.grid);
+        out.fill(0.0);
+        let mut history = x[s2..].to_vec();
+        let mut ybar = x[..s2].to_vec();
+        let mut prev = vec![0.0; s2];
+        let mut g = vec![0.0; n];
+        for step in self.steps.iter().rev() {
+            for tap in &self.taps[step.taps.0..step.taps.1] {
+                for (at, block) in [(tap.a, tap.r), (tap.b, tap.s)] {
+                    let blk = &self.coefficients[block..block + s2 * n];
+                    for (j, gj) in g.iter_mut().enumerate() {
+                        *gj = ybar
+                            .iter()
+                            .enumerate()
+                            .map(|(i, yi)| blk[i * n + j] * yi)
+                            .sum();
+                    }
+                    for (p, weight) in [(at.p, 1.0 - at.w), (at.p + 1, at.w)] {
+                        if weight == 0.0 {
+                            continue;
+                        }
+                        let target = if p < m {
+                            &mut out[s2 + p * n..s2 + (p + 1) * n]
+                        } else {
+                            &mut history[(p - m) * n..(p - m + 1) * n]
+                        };
+                        for (t, gj) in target.iter_mut().zip(&g) {
+                            *t += weight * gj;
+                        }
+                    }
+                }
+            }
+            let p = &self.coefficients[step.offset..step.offset + s2 * s2];
+            for (j, pj) in prev.iter_mut().enumerate() {
+                *pj = ybar
+                    .iter()
+                    .enumerate()
+                    .map(|(i, yi)| p[i * s2 + j] * yi)
+                    .sum();
+            }
+            let a = step.start * n;
+            for (pj, hj) in prev.iter_mut().zip(&history[a..a + n]) {
+                *pj += hj;
             }
             std::mem::swap(&mut ybar, &mut prev);
         }

@@ -13,7 +13,7 @@
 
 use crate::error::{Result, StabilityError, check_condition};
 use crate::grid::segments;
-use crate::monodromy::{Discretization, Monodromy, Scheme, Step};
+use crate::monodromy::{Discretization, Interp, Monodromy, Scheme, Step, Tap, principal_period};
 use chatter_dynamics::{ModalModel, Operation};
 use nalgebra::DMatrix;
 
@@ -71,6 +71,25 @@ impl Periodic<'_> {
                 }
                 m[p * 2 * n + q] = w;
                 m[p * 2 * n + n + q] = pd;
+            }
+        }
+    }
+
+    /// Append tooth `tooth`'s W_j = Phi^T H_j(t) Phi (N x N, row-major) at time `t` to `out`.
+    fn push_tooth(&self, tooth: usize, t: f64, out: &mut Vec<f64>) {
+        let n = self.modes;
+        let h = self
+            .model
+            .tooth_directional_matrix(tooth, t, self.speed_rpm);
+        for p in 0..n {
+            for q in 0..n {
+                let mut w = 0.0;
+                for a in 0..2 {
+                    for c in 0..2 {
+                        w += self.phi[a * n + p] * self.phi[c * n + q] * h[(a, c)];
+                    }
+                }
+                out.push(w);
             }
         }
     }
@@ -207,6 +226,65 @@ impl FullSegment {
     }
 }
 
+impl FullSegment {
+    /// [`Self::step`] with one delayed input per tooth in the cut (variable pitch): the delayed
+    /// term C_1 B_i q_{i-m} + F_2/h B_j q_{i-m+1} becomes the sum over teeth of
+    /// C_1 B_i^(t) q(t_i - tau_t) + F_2/h B_j^(t) q(t_j - tau_t), B^(t) = [[0], [b W_t]];
+    /// appends P, then R_t and S_t of each tooth in `wi`/`wj` order (b W_t at the step's start
+    /// and end, N x N row-major).
+    fn step_teeth(
+        &self,
+        n: usize,
+        (mi, mj): (&[f64], &[f64]),
+        (wi, wj): (&[Vec<f64>], &[Vec<f64>]),
+        out: &mut Vec<f64>,
+    ) -> bool {
+        let (phi0, c1, f2h) = (&self.phi0, &self.c1, &self.f2h);
+        let d = 2 * n;
+        let teeth = wi.len();
+        let k = d + 2 * n * teeth;
+        let mut lhs = vec![0.0; d * d];
+        let mut rhs = vec![0.0; d * k];
+        for r in 0..d {
+            lhs[r * d + r] = 1.0;
+            for c in 0..d {
+                let (mut f2a, mut c1a) = (0.0, 0.0);
+                for q in 0..n {
+                    f2a += f2h[r * d + n + q] * mj[q * d + c];
+                    c1a += c1[r * d + n + q] * mi[q * d + c];
+                }
+                lhs[r * d + c] += f2a;
+                rhs[r * k + c] = phi0[r * d + c] - c1a;
+            }
+            for t in 0..teeth {
+                for c in 0..n {
+                    let (mut c1b, mut f2b) = (0.0, 0.0);
+                    for q in 0..n {
+                        c1b += c1[r * d + n + q] * wi[t][q * n + c];
+                        f2b += f2h[r * d + n + q] * wj[t][q * n + c];
+                    }
+                    rhs[r * k + d + 2 * n * t + c] = c1b;
+                    rhs[r * k + d + 2 * n * t + n + c] = f2b;
+                }
+            }
+        }
+        if !solve_small(&mut lhs, &mut rhs, d, k) {
+            return false;
+        }
+        for r in 0..d {
+            out.extend_from_slice(&rhs[r * k..r * k + d]);
+        }
+        for t in 0..teeth {
+            for block in [d + 2 * n * t, d + 2 * n * t + n] {
+                for r in 0..d {
+                    out.extend_from_slice(&rhs[r * k + block..r * k + block + n]);
+                }
+            }
+        }
+        true
+    }
+}
+
 /// Gauss-Legendre points (fractions of the step) and weights of the semi-discretization's step
 /// mean of the periodic coefficients.
 fn gauss_points() -> [(f64, f64); 3] {
@@ -217,9 +295,28 @@ fn gauss_points() -> [(f64, f64); 3] {
     ]
 }
 
+/// One tooth in the cut on a variable-pitch segment: its W_t per unit depth where the steps
+/// sample the coefficients (as [`Segment::Cutting`]'s `unit`) and, per step, where its delayed
+/// displacements lie in the history.
+#[derive(Debug, Clone)]
+struct ToothInput {
+    unit: Vec<f64>,
+    taps: Vec<(Interp, Interp)>,
+}
+
 /// One segment of the grid, with what its steps need at any depth.
 #[derive(Debug, Clone)]
 enum Segment {
+    /// Variable pitch: cutting steps as [`Segment::Cutting`] (`unit` the total [W | P]), with
+    /// one delayed input per tooth in the cut, tooth t's delay pitch_t / Omega.
+    Teeth {
+        start_s: f64,
+        steps: usize,
+        h: f64,
+        full: Option<FullSegment>,
+        unit: Vec<f64>,
+        teeth: Vec<ToothInput>,
+    },
     /// No tooth cuts: one exact step e^{A_0 L} (row-major) of length L.
     Free { exp: Vec<f64>, length_s: f64 },
     /// `steps` cutting steps of length `h` from `start_s`; `unit` holds [W | P] per unit depth
@@ -255,10 +352,13 @@ impl StepPlan {
         model.require_proportional(method.scheme.name())?;
         let n = model.mode_count();
         let d = 2 * n;
-        let tau = model.operation().delay_s(speed_rpm);
+        let (tau, delays) = principal_period(model, speed_rpm);
         let segs = segments(model, speed_rpm, tau);
         let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
-        let m_cut = method.cutting_steps(model, cutting_time).get();
+        let m_cut = method
+            .cutting_steps(model, cutting_time / delays as f64)
+            .get()
+            * delays;
         let omegas = model.omegas_rad_s();
         let zetas = model.damping_ratios();
         let mut a0 = DMatrix::zeros(d, d);
@@ -274,6 +374,24 @@ impl StepPlan {
             modes: n,
         };
         let constant = matches!(model.operation(), Operation::Turning(_));
+        if model.operation().is_variable_pitch() {
+            let segments = variable_pitch_segments(
+                &periodic,
+                &segs,
+                (m_cut, cutting_time),
+                &a0,
+                method,
+                None,
+            )?;
+            return Ok(Self {
+                modes: n,
+                scheme: method.scheme,
+                a0,
+                segments,
+                constant,
+                period_s: tau,
+            });
+        }
         let segments = segs
             .iter()
             .map(|&(start, end, cutting)| {
@@ -344,13 +462,63 @@ impl StepPlan {
         let mut scratch = (Vec::new(), Vec::new());
         let (mut mi, mut mj) = (vec![0.0; size], vec![0.0; size]);
         let mut grid = 0usize;
+        let mut taps = Vec::new();
         for segment in &self.segments {
             let (start_s, k, h, full, unit) = match segment {
+                Segment::Teeth {
+                    start_s,
+                    steps: k,
+                    h,
+                    full,
+                    unit,
+                    teeth,
+                } => {
+                    for i in 0..*k {
+                        let offset = coefficients.len();
+                        let lengths = self.teeth_step(
+                            depth_m,
+                            (i, *h, full.as_ref()),
+                            unit,
+                            teeth,
+                            &mut coefficients,
+                        );
+                        let Some(blocks) = lengths else {
+                            return Err(StabilityError::NoConvergence {
+                                solver: "full discretization",
+                                detail: format!(
+                                    "singular step matrix at t = {} s",
+                                    start_s + i as f64 * h
+                                ),
+                            });
+                        };
+                        let first = taps.len();
+                        let block = d * n;
+                        for (t, tooth) in teeth.iter().enumerate() {
+                            let (a, b) = tooth.taps[i];
+                            taps.push(Tap {
+                                r: blocks + 2 * t * block,
+                                s: blocks + (2 * t + 1) * block,
+                                a,
+                                b,
+                            });
+                        }
+                        steps.push(Step {
+                            offset,
+                            start: grid,
+                            cutting: true,
+                            taps: (first, taps.len()),
+                        });
+                        step_s.push(*h);
+                        grid += 1;
+                    }
+                    continue;
+                }
                 Segment::Free { exp, length_s } => {
                     steps.push(Step {
                         offset: coefficients.len(),
                         start: grid,
                         cutting: false,
+                        taps: (0, 0),
                     });
                     coefficients.extend_from_slice(exp);
                     step_s.push(*length_s);
@@ -405,6 +573,7 @@ impl StepPlan {
                     offset,
                     start: grid,
                     cutting: true,
+                    taps: (0, 0),
                 });
                 step_s.push(h);
                 grid += 1;
@@ -416,8 +585,84 @@ impl StepPlan {
             steps,
             coefficients,
             step_s,
+            taps,
             self.period_s,
         ))
+    }
+
+    /// Step `i` of a variable-pitch segment at `depth_m`: appends P and each tooth's R and S
+    /// (FDM: [`FullSegment::step_teeth`]; SDM: A_0 + A frozen at its step mean, R_t = C_1 B_t,
+    /// S_t = F_2/h B_t with B_t = [[0], [b mean W_t]]); returns where the R and S blocks start,
+    /// or `None` for a singular FDM step matrix.
+    fn teeth_step(
+        &self,
+        depth_m: f64,
+        (i, h, full): (usize, f64, Option<&FullSegment>),
+        unit: &[f64],
+        teeth: &[ToothInput],
+        out: &mut Vec<f64>,
+    ) -> Option<usize> {
+        let n = self.modes;
+        let d = 2 * n;
+        let size = n * d;
+        let nn = n * n;
+        let scale = |u: &[f64]| u.iter().map(|v| depth_m * v).collect::<Vec<f64>>();
+        match full {
+            Some(full) => {
+                let mi = scale(&unit[i * size..(i + 1) * size]);
+                let mj = scale(&unit[(i + 1) * size..(i + 2) * size]);
+                let wi: Vec<Vec<f64>> = teeth
+                    .iter()
+                    .map(|t| scale(&t.unit[i * nn..(i + 1) * nn]))
+                    .collect();
+                let wj: Vec<Vec<f64>> = teeth
+                    .iter()
+                    .map(|t| scale(&t.unit[(i + 1) * nn..(i + 2) * nn]))
+                    .collect();
+                let at = out.len() + d * d;
+                full.step_teeth(n, (&mi, &mj), (&wi, &wj), out)
+                    .then_some(at)
+            }
+            None => {
+                let gauss = gauss_points();
+                let mean_of = |u: &[f64], len: usize| {
+                    let mut mean = vec![0.0; len];
+                    for (j, (_, wgt)) in gauss.iter().enumerate() {
+                        for (a, b) in mean
+                            .iter_mut()
+                            .zip(&u[(3 * i + j) * len..(3 * i + j + 1) * len])
+                        {
+                            *a += wgt * depth_m * b;
+                        }
+                    }
+                    mean
+                };
+                let mean = mean_of(unit, size);
+                let mut a = self.a0.clone();
+                for p in 0..n {
+                    for c in 0..d {
+                        a[(n + p, c)] -= mean[p * d + c];
+                    }
+                }
+                let (e, f1, f2) = exp_integrals(&a, h);
+                let c1 = &f1 - &f2 / h;
+                let f2h = &f2 / h;
+                out.extend(row_major(&e));
+                let at = out.len();
+                for tooth in teeth {
+                    let w = mean_of(&tooth.unit, nn);
+                    let mut bm = DMatrix::zeros(d, n);
+                    for p in 0..n {
+                        for c in 0..n {
+                            bm[(n + p, c)] = w[p * n + c];
+                        }
+                    }
+                    out.extend(row_major(&(&c1 * &bm)));
+                    out.extend(row_major(&(&f2h * &bm)));
+                }
+                Some(at)
+            }
+        }
     }
 
     /// Semi-discretization step (Insperger and Stépán): A_0 + A frozen at the step's mean of
@@ -457,4 +702,322 @@ impl StepPlan {
         out.extend(row_major(&((&f1 - &f2 / h) * &bm)));
         out.extend(row_major(&(&f2 / h * &bm)));
     }
+}
+
+/// Tooth angles under a sinusoidal spindle-speed variation, Omega(t) = Omega_0 (1 + A sin(w_m t))
+/// (Insperger & Stépán 2004; Sastry, Kapoor & DeVor 2002): the angle is Omega_0 s(t) with the
+/// equivalent constant-speed time s(t) = t - (A / w_m) (cos(w_m t) - 1), increasing for A < 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TimeMap {
+    pub(crate) amplitude: f64,
+    pub(crate) omega_m: f64,
+}
+
+impl TimeMap {
+    /// s(t).
+    pub(crate) fn equivalent(&self, t: f64) -> f64 {
+        t - self.amplitude / self.omega_m * ((self.omega_m * t).cos() - 1.0)
+    }
+
+    /// The t with s(t) = `s` (Newton from t = s; s' = 1 + A sin(w_m t) >= 1 - A > 0).
+    pub(crate) fn inverse(&self, s: f64) -> f64 {
+        let mut t = s;
+        for _ in 0..100 {
+            let step = (self.equivalent(t) - s) / (1.0 + self.amplitude * (self.omega_m * t).sin());
+            t -= step;
+            if step.abs() <= 1e-15 * (1.0 + t.abs()) {
+                break;
+            }
+        }
+        t
+    }
+}
+
+impl StepPlan {
+    /// The plan of `method` for `model` at the mean speed `speed_rpm` under the spindle-speed
+    /// variation of relative amplitude `amplitude_ratio` in (0, 1) at `frequency_ratio` times the
+    /// mean spindle frequency: the principal period is the modulation period T_m, which must hold
+    /// a whole number q = N / frequency_ratio of mean tooth periods (of revolutions in turning),
+    /// the grid is cut at every tooth entry and exit in true time, and each step's delayed points
+    /// are where the tooth ahead passed the same angle (the time-varying delay, interpolated in
+    /// the history). Models with process damping are refused (the cutting speed varies too).
+    pub(crate) fn with_speed_variation(
+        model: &ModalModel,
+        speed_rpm: f64,
+        method: Discretization,
+        (amplitude_ratio, frequency_ratio): (f64, f64),
+    ) -> Result<Self> {
+        check_condition(speed_rpm, 0.0)?;
+        model.require_proportional(method.scheme.name())?;
+        if model.process_damping_n_per_m().is_some_and(|c| c > 0.0) {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: "process_damping with a spindle-speed variation (the cutting speed varies \
+                         along the cut) is not modelled"
+                    .into(),
+            });
+        }
+        let op = model.operation();
+        let delays = op.delays_per_revolution();
+        let q_real = delays as f64 / frequency_ratio;
+        let q = q_real.round();
+        if !(q >= 1.0 && (q_real - q).abs() <= 1e-9 * q_real) {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: format!(
+                    "ssv_frequency_ratio = {frequency_ratio}: the modulation period must hold a \
+                     whole number of tooth periods (revolutions in turning), i.e. a ratio \
+                     {delays} / q for an integer q >= 1 (here {delays} / {frequency_ratio} = {q_real})"
+                ),
+            });
+        }
+        let q = q as usize;
+        let tau = op.delay_s(speed_rpm);
+        let period = q as f64 * tau;
+        let revolution = 60.0 / speed_rpm;
+        let omega = 2.0 * std::f64::consts::PI / revolution;
+        let map = TimeMap {
+            amplitude: amplitude_ratio,
+            omega_m: 2.0 * std::f64::consts::PI / period,
+        };
+        // breakpoints in equivalent time: every entry and exit over the q delays
+        let mut cuts = vec![0.0, period];
+        if let Operation::Milling(m) = op {
+            let (entry, exit) = m.entry_exit_rad();
+            let revolutions = (period / revolution).ceil() as usize + 1;
+            for k in 0..revolutions {
+                for j in 0..m.teeth() {
+                    for angle in [entry, exit] {
+                        let s = ((angle - m.tooth_offset_rad(j)) / omega).rem_euclid(revolution)
+                            + k as f64 * revolution;
+                        if s > 1e-12 * period && s < period * (1.0 - 1e-12) {
+                            cuts.push(s);
+                        }
+                    }
+                }
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * period);
+        let segs: Vec<(f64, f64, bool)> = cuts
+            .windows(2)
+            .map(|w| {
+                let mid = 0.5 * (w[0] + w[1]);
+                let cutting = model.directional_matrix(mid, speed_rpm).abs().max() > 0.0;
+                (map.inverse(w[0]), map.inverse(w[1]), cutting)
+            })
+            .collect();
+        let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
+        let m_cut = method.cutting_steps(model, cutting_time / q as f64).get() * q;
+        let n = model.mode_count();
+        let d = 2 * n;
+        let omegas = model.omegas_rad_s();
+        let zetas = model.damping_ratios();
+        let mut a0 = DMatrix::zeros(d, d);
+        for i in 0..n {
+            a0[(i, n + i)] = 1.0;
+            a0[(n + i, i)] = -omegas[i] * omegas[i];
+            a0[(n + i, n + i)] = -2.0 * zetas[i] * omegas[i];
+        }
+        let periodic = Periodic {
+            model,
+            speed_rpm,
+            phi: row_major(&model.shape_matrix()),
+            modes: n,
+        };
+        let segments = variable_pitch_segments(
+            &periodic,
+            &segs,
+            (m_cut, cutting_time),
+            &a0,
+            method,
+            Some(map),
+        )?;
+        Ok(Self {
+            modes: n,
+            scheme: method.scheme,
+            a0,
+            segments,
+            constant: false,
+            period_s: period,
+        })
+    }
+}
+
+/// The segments of a variable-pitch cutter over one revolution `period` (grid `segs` cut at every
+/// tooth's entry and exit): free flight as for even pitch; cutting segments with
+/// `m_cut` steps over the `cutting_time` in proportion to their length, the total [W | P] and
+/// each cutting tooth's W_t sampled as [`StepPlan::new`] samples them, and each tooth's delayed
+/// points t_k - tau_t, t_{k+1} - tau_t located in the history (linear interpolation between grid
+/// points; on the grid itself when the teeth's cuts do not overlap, since every tooth's cut then
+/// gets the same steps).
+///
+/// With a spindle-speed variation (`map`, [`TimeMap`]) the segments are in true time, the
+/// coefficients are sampled at the equivalent constant-speed time of the tooth angles, and each
+/// tooth's delay is the time the spindle takes to turn its pitch before the step's points.
+fn variable_pitch_segments(
+    periodic: &Periodic,
+    segs: &[(f64, f64, bool)],
+    (m_cut, cutting_time): (usize, f64),
+    a0: &DMatrix<f64>,
+    method: Discretization,
+    map: Option<TimeMap>,
+) -> Result<Vec<Segment>> {
+    let operation = periodic.model.operation();
+    let pitch = |j: usize| match operation {
+        Operation::Milling(m) => m.tooth_pitch_rad(j),
+        Operation::Turning(_) => 2.0 * std::f64::consts::PI,
+    };
+    let equivalent = |t: f64| map.map_or(t, |m| m.equivalent(t));
+    let omega = 2.0 * std::f64::consts::PI * periodic.speed_rpm / 60.0;
+    let period = segs.last().map_or(0.0, |s| s.1);
+    // steps per segment and the grid times
+    let counts: Vec<usize> = segs
+        .iter()
+        .map(|&(start, end, cutting)| {
+            if cutting {
+                ((m_cut as f64 * (end - start) / cutting_time).round() as usize).max(1)
+            } else {
+                1
+            }
+        })
+        .collect();
+    let mut times = vec![0.0];
+    for (&(start, end, _), &k) in segs.iter().zip(&counts) {
+        let h = (end - start) / k as f64;
+        for i in 1..k {
+            times.push(start + i as f64 * h);
+        }
+        times.push(end);
+    }
+    let grid = times.len() - 1;
+    let locate = |u: f64, step: usize| -> Result<Interp> {
+        // u in [0, 2 T): the previous period's grid, then this one's
+        if u < -1e-12 * period {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: format!(
+                    "a delay longer than the principal period ({period} s): the history holds \
+                     one period"
+                ),
+            });
+        }
+        let (base, v) = if u >= period {
+            (grid, u - period)
+        } else {
+            (0, u.max(0.0))
+        };
+        let i = times
+            .partition_point(|t| *t <= v)
+            .saturating_sub(1)
+            .min(grid - 1);
+        let w = (v - times[i]) / (times[i + 1] - times[i]);
+        let at = if w > 1.0 - 1e-9 {
+            Interp {
+                p: base + i + 1,
+                w: 0.0,
+            }
+        } else if w < 1e-9 {
+            Interp {
+                p: base + i,
+                w: 0.0,
+            }
+        } else {
+            Interp { p: base + i, w }
+        };
+        if at.p + usize::from(at.w > 0.0) > grid + step {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: format!(
+                    "operation.pitch_deg: a pitch shorter than one step of the grid ({} s); \
+                     use more steps",
+                    times[i + 1] - times[i]
+                ),
+            });
+        }
+        Ok(at)
+    };
+    let mut out = Vec::with_capacity(segs.len());
+    let mut first_step = 0usize;
+    for (&(start, end, cutting), &k) in segs.iter().zip(&counts) {
+        let len = end - start;
+        if !cutting {
+            out.push(Segment::Free {
+                exp: row_major(&(a0 * len).exp()),
+                length_s: len,
+            });
+            first_step += 1;
+            continue;
+        }
+        let h = len / k as f64;
+        // the sample times of the scheme, as StepPlan::new takes them
+        let samples: Vec<f64> = match method.scheme {
+            Scheme::Full => {
+                let eps = 1e-9 * h;
+                std::iter::once(start + eps)
+                    .chain((0..k).map(|i| start + i as f64 * h + h - eps))
+                    .collect()
+            }
+            Scheme::Semi => (0..k)
+                .flat_map(|i| gauss_points().map(|(x, _)| start + i as f64 * h + x * h))
+                .collect(),
+        };
+        let mut unit = Vec::new();
+        for &t in &samples {
+            periodic.push(equivalent(t), &mut unit);
+        }
+        let mid = equivalent(0.5 * (start + end));
+        let mut teeth = Vec::new();
+        for j in 0..operation.delays_per_revolution() {
+            if periodic
+                .model
+                .tooth_directional_matrix(j, mid, periodic.speed_rpm)
+                .abs()
+                .max()
+                == 0.0
+            {
+                continue;
+            }
+            let mut tooth_unit = Vec::new();
+            for &t in &samples {
+                periodic.push_tooth(j, equivalent(t), &mut tooth_unit);
+            }
+            let tau = pitch(j) / omega;
+            let taps = (0..k)
+                .map(|i| {
+                    let t0 = start + i as f64 * h;
+                    let step = first_step + i;
+                    Ok(match map {
+                        None => (
+                            locate(t0 - tau + period, step)?,
+                            locate(t0 + h - tau + period, step)?,
+                        ),
+                        // the time the tooth ahead passed the same angle
+                        Some(m) => (
+                            locate(m.inverse(m.equivalent(t0) - tau) + period, step)?,
+                            locate(m.inverse(m.equivalent(t0 + h) - tau) + period, step)?,
+                        ),
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?;
+            teeth.push(ToothInput {
+                unit: tooth_unit,
+                taps,
+            });
+        }
+        let full = match method.scheme {
+            Scheme::Full => Some(FullSegment::new(a0, h)),
+            Scheme::Semi => None,
+        };
+        out.push(Segment::Teeth {
+            start_s: start,
+            steps: k,
+            h,
+            full,
+            unit,
+            teeth,
+        });
+        first_step += k;
+    }
+    Ok(out)
 }

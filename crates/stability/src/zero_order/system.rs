@@ -176,6 +176,7 @@ impl OrientedSystem {
 
     /// The system of `model`: its modes and [`ModalModel::average_directional_matrix`].
     pub fn from_model(model: &ModalModel) -> Result<Self> {
+        refuse_variable_pitch(model)?;
         let a = model.average_directional_matrix();
         let modes = model
             .modes()
@@ -343,6 +344,26 @@ pub(crate) fn principal_sqrt(z: Complex64) -> Complex64 {
         Complex64::new(t, 0.5 * z.im / t)
     } else {
         Complex64::new(0.5 * z.im.abs() / t, t.copysign(z.im))
+    }
+}
+
+/// The zero-order method here is the even-pitch one (one delay, Altintas and Budak 1995); a
+/// variable-pitch cutter (several delays; Altintas, Engin and Budak 1999) is refused by the
+/// field's name and values. FDM and SDM handle it.
+pub(crate) fn refuse_variable_pitch(model: &ModalModel) -> Result<()> {
+    match model.operation() {
+        chatter_dynamics::Operation::Milling(m) if m.is_variable_pitch() => {
+            Err(crate::StabilityError::Unsupported {
+                method: "zoa",
+                reason: format!(
+                    "operation.pitch_deg = {:?} is a variable-pitch cutter (one delay per tooth); \
+                     the zero-order method here assumes even pitch (the variable-pitch form of \
+                     Altintas, Engin and Budak 1999 is not implemented): use fdm or sdm",
+                    m.pitch_deg().unwrap_or_default()
+                ),
+            })
+        }
+        _ => Ok(()),
     }
 }
 
