@@ -215,8 +215,10 @@ mod tests {
 
     #[test]
     fn label_discrepancy_is_standardized() {
+        // at p = 1/2 every label is equally surprising: no discrepancy
+        assert_eq!(label_discrepancy(0.5, true), 0.0);
         // mean 0 and variance 1 under the model's own labels
-        for p in [0.02, 0.3, 0.5, 0.9] {
+        for p in [0.02, 0.3, 0.7, 0.9] {
             let (a, b) = (label_discrepancy(p, true), label_discrepancy(p, false));
             let mean = p * a + (1.0 - p) * b;
             let var = p * a * a + (1.0 - p) * b * b - mean * mean;
