@@ -1,6 +1,6 @@
 //! The localized posterior predictive check: does the misfit concentrate in one band of speeds?
 //!
-//! The global check ([`crate::check`]) sums each observable's discrepancy over the whole
+//! The global check (`check`) sums each observable's discrepancy over the whole
 //! campaign, so an effect confined to a band of speeds (cutting coefficients doubled within
 //! +-8 % of one speed, damping raised in a band, cutting coefficients rising at low cutting
 //! speed) hides among the many observations it does not touch. This check scans every band of
@@ -10,7 +10,7 @@
 //! - every observation gives standardized discrepancies: a cut's label its surprisal
 //!   -ln p(y) minus the expected surprisal (the entropy), over the surprisal's standard deviation
 //!   sqrt(p (1 - p)) |ln(p / (1 - p))|; a chatter frequency, a pole frequency and a pole damping
-//!   ratio their squared standardized residual capped at [`OUTLIER_CAP`] (one outlier is
+//!   ratio their squared standardized residual capped at `OUTLIER_CAP` (10.83, as the global check) (one outlier is
 //!   allowed, as in the global check), minus 1, over sqrt 2;
 //! - the observations are ordered by speed and every run of consecutive speeds holding at least
 //!   [`MIN_BAND`] discrepancies and at most half of them is a band, scored by the sum of its
