@@ -50,22 +50,27 @@ pub struct PredictiveCheck {
 }
 
 impl PredictiveCheck {
-    /// The band of speeds (rpm) whose localized check fails at the Bonferroni level: where the
-    /// misfit concentrates beyond what the noise allows ([`crate::local`]).
-    pub fn failing_band(&self) -> Option<(f64, f64)> {
-        let types = [
+    /// The p-values of the check (None for observable types without observations).
+    fn p_values(&self) -> [Option<f64>; 5] {
+        [
             self.cut_labels,
             self.chatter_frequencies,
             self.pole_frequencies,
             self.pole_damping,
             self.local.map(|l| l.p_value),
         ]
-        .iter()
-        .flatten()
-        .count()
-        .max(1) as f64;
+    }
+
+    /// The level each p-value is held to: the family-wise level over their number (Bonferroni).
+    fn bonferroni_level(&self) -> f64 {
+        self.level / self.p_values().iter().flatten().count().max(1) as f64
+    }
+
+    /// The band of speeds (rpm) whose localized check fails at the Bonferroni level: where the
+    /// misfit concentrates beyond what the noise allows ([`crate::local`]).
+    pub fn failing_band(&self) -> Option<(f64, f64)> {
         self.local
-            .filter(|l| l.p_value < self.level / types)
+            .filter(|l| l.p_value < self.bonferroni_level())
             .map(|l| (l.from_rpm, l.to_rpm))
     }
 }
@@ -159,24 +164,23 @@ pub(crate) fn predictive_check(
     }
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     let local = local_check(predictions, data, noise, seed);
-    let values = [
-        mean(&label_p),
-        mean(&chatter_p),
-        mean(&pole_f_p),
-        mean(&pole_z_p),
-        local.map(|l| l.p_value),
-    ];
-    let types = values.iter().flatten().count().max(1) as f64;
-    let smallest = values.iter().flatten().copied().fold(1.0, f64::min);
-    PredictiveCheck {
-        cut_labels: values[0],
-        chatter_frequencies: values[1],
-        pole_frequencies: values[2],
-        pole_damping: values[3],
+    let mut check = PredictiveCheck {
+        cut_labels: mean(&label_p),
+        chatter_frequencies: mean(&chatter_p),
+        pole_frequencies: mean(&pole_f_p),
+        pole_damping: mean(&pole_z_p),
         local,
         level,
-        passed: smallest >= level / types,
-    }
+        passed: false,
+    };
+    let smallest = check
+        .p_values()
+        .iter()
+        .flatten()
+        .copied()
+        .fold(1.0, f64::min);
+    check.passed = smallest >= check.bonferroni_level();
+    check
 }
 
 #[cfg(test)]

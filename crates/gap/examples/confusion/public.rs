@@ -145,20 +145,6 @@ pub fn run(dir: &Path, observer: &dyn Observer) -> chatter_gap::Result<()> {
         total += t;
     }
     println!("all | {right}/{total}");
-    closures.sort_by(f64::total_cmp);
-    if !closures.is_empty() {
-        println!(
-            "median held-out closure {:.2} over {} campaigns with a gap",
-            closures[closures.len() / 2],
-            closures.len()
-        );
-    }
-    times.sort_by(f64::total_cmp);
-    if let Some(max) = times.last() {
-        println!(
-            "diagnosis time: median {:.1} s, max {max:.1} s",
-            times[times.len() / 2]
-        );
-    }
+    crate::print_summary(&mut closures, &mut times);
     Ok(())
 }
