@@ -5,6 +5,7 @@ use crate::classes::{ClassModel, EffectClass, Nominal, unavailable};
 use crate::data::Dataset;
 use crate::equivalence::largest_shift;
 use crate::error::{GapError, Result};
+use crate::influence::{Rule, lone_observation};
 use crate::likelihood::{NoiseModel, terms};
 use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
@@ -34,7 +35,8 @@ pub(crate) const PREDICTIVE_SAMPLES: usize = 100;
 pub struct DiagnoseOptions {
     /// Seed of every random choice (samplers, folds, replications).
     pub seed: u64,
-    /// iTMCMC samples per class (per stratum for a class with [`EffectClass::strata`]).
+    /// iTMCMC samples per class (per stratum for a class with [`EffectClass::strata`], as
+    /// [`EffectClass::samples`] sets them).
     pub samples: usize,
     /// Metropolis-Hastings steps per chain and stage.
     pub steps: usize,
@@ -58,7 +60,9 @@ pub struct DiagnoseOptions {
     /// verdict is `consistent` whatever the Bayes factor.
     pub equivalence_std: f64,
     /// Rounds of further Metropolis-Hastings moves of the named class's posterior samples before
-    /// its predictive check (`rejuvenate` of chatter-bayes; the evidence stays the sampler's); 0 turns them off.
+    /// its predictive check (`rejuvenate` of chatter-bayes; the evidence stays the sampler's),
+    /// and when that check fails twice as many more before it is repeated (a failed check must
+    /// be the class's, not a population still on a ridge); 0 turns them off.
     pub polish_rounds: usize,
     /// Held-out validation of the gap's shrinkage.
     pub validation: Validation,
@@ -372,7 +376,7 @@ pub(crate) fn fit<'a>(
     let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta, &count);
     let tmcmc_options = TmcmcOptions {
         steps: class.steps(options.steps),
-        ..options.tmcmc(samples, seed)
+        ..options.tmcmc(class.samples(samples), seed)
     };
     let run = match class.strata() {
         None => tmcmc(&model.prior, &like, &tmcmc_options, observer),
@@ -629,14 +633,29 @@ pub fn diagnose(
     };
     let polish_seed = class_seed(options.seed, fitted[best].model.class, usize::MAX);
     polish(&mut fitted[best], &data, &options, polish_seed, observer)?;
-    let predictions = posterior_predictions(&fitted[best], &data);
-    let check = predictive_check(
-        &predictions,
+    let mut check = predictive_check(
+        &posterior_predictions(&fitted[best], &data),
         &data,
         &options.noise,
         options.check_level,
         options.seed,
     );
+    // a failed check must be the class's, not an unconverged population's: twice the rounds
+    // once more before the class is given up
+    if !check.passed && options.polish_rounds > 0 {
+        let again = DiagnoseOptions {
+            polish_rounds: 2 * options.polish_rounds,
+            ..options.clone()
+        };
+        polish(&mut fitted[best], &data, &again, polish_seed ^ 1, observer)?;
+        check = predictive_check(
+            &posterior_predictions(&fitted[best], &data),
+            &data,
+            &options.noise,
+            options.check_level,
+            options.seed,
+        );
+    }
     let best_class = fitted[best].model.class;
     // the nominal model is a class without parameters: its evidence is its likelihood
     let nominal_variant = nominal.variant();
@@ -663,10 +682,32 @@ pub fn diagnose(
         &data,
         &options.noise,
     );
+    let log_bayes_factor = alternative_log_evidence - nominal_log_evidence;
     let consistent = nominal_check.passed
-        && (alternative_log_evidence - nominal_log_evidence
-            < options.min_log_bayes_factor_against_nominal
+        && (log_bayes_factor < options.min_log_bayes_factor_against_nominal
             || practical_shift < options.equivalence_std);
+    // a rejection that one observation carries alone is not one
+    let lone = if consistent {
+        None
+    } else {
+        lone_observation(
+            (&nominal_variant, &nominal_prediction),
+            (&candidate, &candidate_prediction),
+            &data,
+            log_bayes_factor,
+            &Rule {
+                noise: &options.noise,
+                check_level: options.check_level,
+                seed: options.seed,
+                min_log_bayes_factor: options.min_log_bayes_factor_against_nominal,
+                equivalence_std: options.equivalence_std,
+            },
+        )
+    };
+    if let Some(lone) = lone {
+        notes.push(lone.note());
+    }
+    let consistent = consistent || lone.is_some();
     let verdict = if consistent {
         Verdict::Consistent
     } else if check.passed {

@@ -31,7 +31,10 @@
 //! 10, or the best class is practically equivalent to it ([`equivalence`]: no observation's
 //! prediction moves by more than one noise standard deviation); otherwise the best class when it
 //! passes the check; otherwise `unexplained`. The check includes a localized scan over bands of
-//! speeds ([`local`]); when that part fails, the `unexplained` verdict names the band.
+//! speeds ([`local`]); when that part fails, the `unexplained` verdict names the band. A
+//! rejection of the nominal model that one observation carries alone (without it the nominal
+//! model would be `consistent`) gives `consistent` with a note naming that observation
+//! (`influence`): one gross misidentification is not a model error.
 //!
 //! # Outside proving ground
 //! Twenty campaigns of an outside generator (`../shared/data/gap_public`, its README; truth a
@@ -43,18 +46,22 @@
 //! | machine | control | 1x | 2x | outside the list |
 //! |---|---|---|---|---|
 //! | A: xy milling 30 % | 1/1 | 2/2 (parameter error, speed-dependent dynamics) | 1/1 (process damping) | 0/1 (cutting x3 in a band: `consistent`, nominal misses 4/40) |
-//! | B: low immersion | 1/1 | 0/1 (drift taken for `extra_mode`) | 1/2 (parameter error right; extra mode `unexplained`) | 0/1 (damping band: `parameter_error`) |
+//! | B: low immersion | 1/1 | 0/1 (drift taken for `parameter_error`) | 1/2 (parameter error right; extra mode `unexplained`) | 1/1 (damping band, seen in one pole: `consistent`, nominal misses 0/40) |
 //! | C: turning | 1/1 | 2/2 (process damping, extra mode) | 1/1 (speed-dependent dynamics) | 0/1 (cutting rising at low speed: `process_damping`) |
 //! | D: two modes in x | 1/1 | 1/1 (parameter error) | 2/2 (drift, process damping) | 1/1 (`consistent`, nominal misses 1/40) |
 //!
-//! 15/20 right (before this version 10/20: every turning campaign `unexplained`, because the
-//! likelihood held pole frequencies to 0.3 % while the identification scatters by 1 %; the noise
-//! scale is now integrated out, [`likelihood`]); every control `consistent`; median held-out
-//! closure 0.67 over the 13 campaigns with a gap (nominal misses >= 2 of 40). Still missed: three of
-//! four effects outside the list (a gap confined to one or two observations of a band is not
-//! told from an outlier by the localized check), drift 1x and extra mode 2x on the
-//! low-immersion machine. Time per campaign 45-260 s on the shared two cores (three other jobs
-//! running); the 30 s target for a 40-cut, 8-pole campaign is not met.
+//! 16/20 right (10/20 before the pole-frequency noise scale was integrated out, [`likelihood`];
+//! 15/20 before the gap resting on one observation became `consistent`, `influence`); every
+//! control `consistent`; median held-out closure 0.67 over the 13 campaigns with a gap (nominal
+//! misses >= 2 of 40). Still missed: the cutting-coefficient band (its band holds one
+//! surprising label; the localized likelihood-ratio scan finds the band, 10 794-13 109 rpm
+//! against the true 11 283-13 245, at p = 0.004, above the level 0.002), the lathe's cutting
+//! coefficients rising at low speed (`process_damping` passes every check and predicts the
+//! held-out cuts worse than the nominal model, 7 misses against 5), drift 1x on the
+//! low-immersion machine (drift beats recalibration by 1.5 nats, short of the 2.3 an effect
+//! needs) and its extra mode 2x (the fitted extra mode leaves chatter frequencies failing the
+//! check, p = 0.0015). CPU time per campaign: 54 s on average (17.9 min of user time for the
+//! 20); wall time 40-330 s on the shared two cores while three other builds ran.
 //!
 //! # Model: which approximation is used where
 //! - **Inside the samplers and the checks** every prediction is one Floquet multiplier of the
@@ -119,6 +126,7 @@ pub mod diagnose;
 pub mod equivalence;
 pub mod error;
 pub mod generator;
+mod influence;
 pub mod likelihood;
 pub mod local;
 pub mod predict;

@@ -1,26 +1,33 @@
 //! The localized posterior predictive check: does the misfit concentrate in one band of speeds?
 //!
 //! The global check (`check`) sums each observable's discrepancy over the whole
-//! campaign, so an effect confined to a band of speeds (cutting coefficients doubled within
-//! +-8 % of one speed, damping raised in a band, cutting coefficients rising at low cutting
+//! campaign, so an effect confined to a band of speeds (cutting coefficients raised within a few
+//! per cent of one speed, damping raised in a band, cutting coefficients rising at low cutting
 //! speed) hides among the many observations it does not touch. This check scans every band of
-//! speeds instead (a scan statistic, Kulldorff 1997, "A spatial scan statistic"; the maximum over
-//! the bands is its own multiplicity correction):
+//! speeds instead, with the likelihood-ratio scan statistic of Kulldorff (1997, "A spatial scan
+//! statistic"): in each band the alternative is that the model is off there by a common amount,
+//! the null that it is right, and the maximum over the bands carries its own multiplicity
+//! correction.
 //!
-//! - every observation gives standardized discrepancies: a cut's label its surprisal
-//!   -ln p(y) minus the expected surprisal (the entropy), over the surprisal's standard deviation
-//!   sqrt(p (1 - p)) |ln(p / (1 - p))|; a chatter frequency, a pole frequency and a pole damping
-//!   ratio their squared standardized residual capped at `OUTLIER_CAP` (10.83, as the global check) (one outlier is
-//!   allowed, as in the global check), minus 1, over sqrt 2;
-//! - the observations are ordered by speed and every run of consecutive speeds holding at least
-//!   [`MIN_BAND`] discrepancies and at most half of them is a band, scored by the sum of its
-//!   discrepancies over the square root of their number;
-//! - the statistic is the largest band score; its p-value is the share of replicated campaigns
-//!   (labels drawn from each cut's chatter probability, squared residuals from chi^2_1, the
-//!   same items) whose largest band score is at least as large, averaged over posterior samples.
+//! - Labels: inside the band the true boundary lies a common factor e^delta from the predicted
+//!   one, so each cut's log-depth distance d = ln(b / b_lim) becomes d + delta (a regional error
+//!   of the cutting coefficient, the damping or the stiffness moves the limit so). The band's
+//!   label statistic is max over delta of sum [ln p(y_i | d_i + delta) - ln p(y_i | d_i)], delta
+//!   on a grid of +-[`DELTA_GRID`] (0 included, so it is >= 0); p is the likelihood's probit
+//!   with its lapse, so one mislabel gains at most ln(1 / lapse).
+//! - Chatter frequencies, pole frequencies and pole damping ratios: their standardized
+//!   residuals z_i, each clipped to +-sqrt([`OUTLIER_CAP`]) as the global check caps them, are
+//!   off by a common mean in the band; each kind adds its Gaussian likelihood ratio
+//!   (sum z_i)^2 / (2 n).
+//! - Every run of consecutive speeds holding at least [`MIN_BAND`] observations and at most half
+//!   of them is a band; the statistic is the largest band's likelihood ratio. Its p-value is the
+//!   share of replicated campaigns (labels drawn from each cut's chatter probability, residuals
+//!   from N(0, 1) and clipped, the same items) whose largest band statistic is at least as large,
+//!   pooled over the posterior samples ([`REPLICATES`] in all, enough to resolve the Bonferroni
+//!   level of the check).
 //!
-//! The band of the largest score is reported, so an `unexplained` verdict names where the model
-//! fails.
+//! The band of the largest statistic is reported, so an `unexplained` verdict names where the
+//! model fails.
 
 use crate::check::OUTLIER_CAP;
 use crate::data::Dataset;
@@ -31,19 +38,24 @@ use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
 use serde::Serialize;
 
-/// Fewest discrepancies in a band: a single observation is the lapse's business, not a region's.
+/// Fewest observations in a band: a single observation is the lapse's business, not a region's.
 pub const MIN_BAND: usize = 3;
 
-/// Replicated campaigns behind the p-value, shared out over the posterior samples.
-const REPLICATES: usize = 400;
+/// Replicated campaigns behind the p-value, shared out over the posterior samples: with 4000
+/// the smallest p-value, 1/4001, lies well below the check's Bonferroni level 0.01 / 5.
+const REPLICATES: usize = 4000;
+
+/// The positive regional log-depth offsets delta tried for the labels (each also negated): a
+/// boundary 5 % to a factor 4 off, about 1.3 label widths apart near zero.
+const DELTA_GRID: [f64; 10] = [0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.75, 1.0, 1.4];
 
 /// The result of the localized check.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct LocalCheck {
-    /// Posterior predictive p-value of the largest band score.
+    /// Posterior predictive p-value of the largest band statistic.
     pub p_value: f64,
-    /// The largest band score (sum of standardized discrepancies over the square root of their
-    /// number), at the posterior sample of median score.
+    /// The largest band statistic (the ln likelihood ratio of a common regional offset), at the
+    /// posterior sample of median statistic.
     pub score: f64,
     /// Lowest speed of that band (rpm).
     pub from_rpm: f64,
@@ -53,31 +65,22 @@ pub struct LocalCheck {
     pub observations: usize,
 }
 
-/// How a discrepancy is replicated under the model.
+/// Kinds of standardized residuals, each with its own regional mean offset.
+const RESIDUAL_KINDS: usize = 3;
+
+/// One observation of the scan.
 #[derive(Debug, Clone, Copy)]
 enum Item {
-    /// A cut's label with chatter probability p (observed: chattered or not).
-    Label { p: f64, chattered: bool },
-    /// A squared standardized residual (chi^2_1 under the model).
-    Squared(f64),
+    /// A cut's label: its predicted log-depth distance and whether it chattered.
+    Label { log_distance: f64, chattered: bool },
+    /// A standardized residual of one kind (chatter frequency, pole frequency, pole damping).
+    Residual { kind: usize, z: f64 },
 }
 
-/// The standardized surprisal of a label with chatter probability `p`.
-fn label_discrepancy(p: f64, chattered: bool) -> f64 {
-    let p = p.clamp(1e-12, 1.0 - 1e-12);
-    let surprisal = -if chattered { p.ln() } else { (1.0 - p).ln() };
-    let entropy = -(p * p.ln() + (1.0 - p) * (1.0 - p).ln());
-    let sd = (p * (1.0 - p)).sqrt() * (p / (1.0 - p)).ln().abs();
-    if sd < 1e-9 {
-        0.0
-    } else {
-        (surprisal - entropy) / sd
-    }
-}
-
-/// The standardized capped squared residual.
-fn squared_discrepancy(z2: f64) -> f64 {
-    (z2.min(OUTLIER_CAP) - 1.0) / std::f64::consts::SQRT_2
+/// Largest standardized residual kept: sqrt of the global check's outlier cap.
+fn clip(z: f64) -> f64 {
+    let cap = OUTLIER_CAP.sqrt();
+    z.clamp(-cap, cap)
 }
 
 /// Every observation's items with their speeds, ordered by speed.
@@ -90,7 +93,7 @@ fn items(prediction: &Prediction, data: &Dataset, noise: &NoiseModel) -> Vec<(f6
         out.push((
             c.speed_rpm,
             Item::Label {
-                p: noise.chatter_probability(q.log_distance()),
+                log_distance: q.log_distance(),
                 chattered: !c.stable,
             },
         ));
@@ -98,7 +101,10 @@ fn items(prediction: &Prediction, data: &Dataset, noise: &NoiseModel) -> Vec<(f6
             let r = nearest_chatter_residual(f, &q, prediction.cut_fold_hz[i]);
             out.push((
                 c.speed_rpm,
-                Item::Squared((r / data.chatter_std_hz).powi(2)),
+                Item::Residual {
+                    kind: 0,
+                    z: clip(r / data.chatter_std_hz),
+                },
             ));
         }
     }
@@ -116,40 +122,139 @@ fn items(prediction: &Prediction, data: &Dataset, noise: &NoiseModel) -> Vec<(f6
             );
             out.push((
                 p.speed_rpm,
-                Item::Squared((rf / p.frequency_std_hz(scale)).powi(2)),
+                Item::Residual {
+                    kind: 1,
+                    z: clip(rf / p.frequency_std_hz(scale)),
+                },
             ));
-            out.push((p.speed_rpm, Item::Squared((rz / p.damping_std).powi(2))));
+            out.push((
+                p.speed_rpm,
+                Item::Residual {
+                    kind: 2,
+                    z: clip(rz / p.damping_std),
+                },
+            ));
         }
     }
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
     out
 }
 
-/// The largest band score of `values` (ordered by `speeds`) and its band (first, last index):
-/// bands start and end between distinct speeds.
-fn largest_band(speeds: &[f64], values: &[f64]) -> (f64, usize, usize) {
-    let n = values.len();
-    let mut prefix = vec![0.0; n + 1];
-    for (k, v) in values.iter().enumerate() {
-        prefix[k + 1] = prefix[k] + v;
-    }
-    let starts: Vec<usize> = (0..n)
-        .filter(|&k| k == 0 || speeds[k] != speeds[k - 1])
-        .collect();
-    let mut best = (f64::NEG_INFINITY, 0, 0);
-    for &a in &starts {
-        for &end in starts.iter().filter(|&&e| e > a).chain(std::iter::once(&n)) {
-            let len = end - a;
-            if len < MIN_BAND || 2 * len > n {
-                continue;
+/// The scan over one campaign's items: bands and the label gains per offset, fixed across
+/// replications.
+struct Scan {
+    /// Bands as (first item, one past the last).
+    bands: Vec<(usize, usize)>,
+    /// The offsets: 0, then +-[`DELTA_GRID`].
+    deltas: Vec<f64>,
+    /// Per label item and offset: ln p(y | d + delta) - ln p(y | d) for y = chatter, y = stable.
+    gains: Vec<Option<Vec<[f64; 2]>>>,
+    /// Per item: its residual kind.
+    kinds: Vec<Option<usize>>,
+}
+
+impl Scan {
+    fn new(speeds: &[f64], items: &[Item], noise: &NoiseModel) -> Self {
+        let n = items.len();
+        let starts: Vec<usize> = (0..n)
+            .filter(|&k| k == 0 || speeds[k] != speeds[k - 1])
+            .collect();
+        let mut bands = Vec::new();
+        for &a in &starts {
+            for &end in starts.iter().filter(|&&e| e > a).chain(std::iter::once(&n)) {
+                let len = end - a;
+                if len >= MIN_BAND && 2 * len <= n {
+                    bands.push((a, end));
+                }
             }
-            let score = (prefix[end] - prefix[a]) / (len as f64).sqrt();
+        }
+        let deltas: Vec<f64> = std::iter::once(0.0)
+            .chain(DELTA_GRID.iter().flat_map(|&d| [d, -d]))
+            .collect();
+        let ln_p = |d: f64, chattered: bool| {
+            let p = noise.chatter_probability(d);
+            if chattered { p.ln() } else { (1.0 - p).ln() }
+        };
+        let gains = items
+            .iter()
+            .map(|item| match *item {
+                Item::Label { log_distance, .. } => Some(
+                    deltas
+                        .iter()
+                        .map(|&delta| {
+                            let d = log_distance + delta;
+                            [
+                                ln_p(d, true) - ln_p(log_distance, true),
+                                ln_p(d, false) - ln_p(log_distance, false),
+                            ]
+                        })
+                        .collect(),
+                ),
+                Item::Residual { .. } => None,
+            })
+            .collect();
+        let kinds = items
+            .iter()
+            .map(|item| match *item {
+                Item::Residual { kind, .. } => Some(kind),
+                Item::Label { .. } => None,
+            })
+            .collect();
+        Self {
+            bands,
+            deltas,
+            gains,
+            kinds,
+        }
+    }
+
+    /// The largest band statistic for the labels `chattered` (per item; ignored for residuals)
+    /// and residuals `z` (per item; ignored for labels), with its band.
+    fn largest(&self, chattered: &[bool], z: &[f64]) -> (f64, usize, usize) {
+        let n = chattered.len();
+        let m = self.deltas.len();
+        // prefix sums of the label gains per offset, and of residuals and counts per kind
+        let mut label = vec![0.0; (n + 1) * m];
+        let mut sums = vec![[0.0; RESIDUAL_KINDS]; n + 1];
+        let mut counts = vec![[0usize; RESIDUAL_KINDS]; n + 1];
+        for k in 0..n {
+            let (row, next) = label.split_at_mut((k + 1) * m);
+            let row = &row[k * m..];
+            match &self.gains[k] {
+                Some(g) => {
+                    let y = usize::from(!chattered[k]);
+                    for j in 0..m {
+                        next[j] = row[j] + g[j][y];
+                    }
+                }
+                None => next[..m].copy_from_slice(row),
+            }
+            sums[k + 1] = sums[k];
+            counts[k + 1] = counts[k];
+            if let Some(kind) = self.kinds[k] {
+                sums[k + 1][kind] += z[k];
+                counts[k + 1][kind] += 1;
+            }
+        }
+        let mut best = (f64::NEG_INFINITY, 0, 0);
+        for &(a, end) in &self.bands {
+            let labels = (0..m)
+                .map(|j| label[end * m + j] - label[a * m + j])
+                .fold(0.0, f64::max);
+            let residuals: f64 = (0..RESIDUAL_KINDS)
+                .filter(|&t| counts[end][t] > counts[a][t])
+                .map(|t| {
+                    let s = sums[end][t] - sums[a][t];
+                    s * s / (2.0 * (counts[end][t] - counts[a][t]) as f64)
+                })
+                .sum();
+            let score = labels + residuals;
             if score > best.0 {
                 best = (score, a, end - 1);
             }
         }
+        best
     }
-    best
 }
 
 /// The localized check over posterior-sample predictions of `data` (None with too few
@@ -160,7 +265,7 @@ pub(crate) fn local_check(
     noise: &NoiseModel,
     seed: u64,
 ) -> Option<LocalCheck> {
-    let per_sample = (REPLICATES / predictions.len().max(1)).max(4);
+    let per_sample = REPLICATES.div_ceil(predictions.len().max(1)).max(4);
     let mut exceed = 0usize;
     let mut total = 0usize;
     let mut observed = Vec::new();
@@ -170,27 +275,29 @@ pub(crate) fn local_check(
             continue;
         }
         let speeds: Vec<f64> = items.iter().map(|(v, _)| *v).collect();
-        let values: Vec<f64> = items
+        let items: Vec<Item> = items.into_iter().map(|(_, item)| item).collect();
+        let scan = Scan::new(&speeds, &items, noise);
+        let (chattered, z): (Vec<bool>, Vec<f64>) = items
             .iter()
-            .map(|(_, item)| match *item {
-                Item::Label { p, chattered } => label_discrepancy(p, chattered),
-                Item::Squared(z2) => squared_discrepancy(z2),
+            .map(|item| match *item {
+                Item::Label { chattered, .. } => (chattered, 0.0),
+                Item::Residual { z, .. } => (false, z),
             })
-            .collect();
-        let (score, a, b) = largest_band(&speeds, &values);
+            .unzip();
+        let (score, a, b) = scan.largest(&chattered, &z);
         let mut rng = StdRng::seed_from_u64(seed ^ (s as u64).wrapping_mul(0xD1B5_4A32_D192_ED03));
+        let (mut chattered, mut z) = (chattered, z);
         for _ in 0..per_sample {
-            let replicated: Vec<f64> = items
-                .iter()
-                .map(|(_, item)| match *item {
-                    Item::Label { p, .. } => label_discrepancy(p, rng.random::<f64>() < p),
-                    Item::Squared(_) => {
-                        let z: f64 = rng.sample(StandardNormal);
-                        squared_discrepancy(z * z)
+            for (k, item) in items.iter().enumerate() {
+                match *item {
+                    Item::Label { log_distance, .. } => {
+                        chattered[k] =
+                            rng.random::<f64>() < noise.chatter_probability(log_distance);
                     }
-                })
-                .collect();
-            exceed += usize::from(largest_band(&speeds, &replicated).0 >= score);
+                    Item::Residual { .. } => z[k] = clip(rng.sample(StandardNormal)),
+                }
+            }
+            exceed += usize::from(scan.largest(&chattered, &z).0 >= score);
             total += 1;
         }
         observed.push((score, speeds[a], speeds[b], b + 1 - a));
@@ -213,33 +320,70 @@ pub(crate) fn local_check(
 mod tests {
     use super::*;
 
-    #[test]
-    fn label_discrepancy_is_standardized() {
-        // at p = 1/2 every label is equally surprising: no discrepancy
-        assert_eq!(label_discrepancy(0.5, true), 0.0);
-        // mean 0 and variance 1 under the model's own labels
-        for p in [0.02, 0.3, 0.7, 0.9] {
-            let (a, b) = (label_discrepancy(p, true), label_discrepancy(p, false));
-            let mean = p * a + (1.0 - p) * b;
-            let var = p * a * a + (1.0 - p) * b * b - mean * mean;
-            assert!(
-                mean.abs() < 1e-12 && (var - 1.0).abs() < 1e-9,
-                "{p}: {mean} {var}"
-            );
-        }
+    fn labels(distances: &[f64], chattered: &[bool]) -> Vec<Item> {
+        distances
+            .iter()
+            .zip(chattered)
+            .map(|(&log_distance, &chattered)| Item::Label {
+                log_distance,
+                chattered,
+            })
+            .collect()
     }
 
     #[test]
-    fn the_largest_band_is_found_between_distinct_speeds() {
+    fn a_band_of_wrong_labels_is_found_and_scored_by_its_likelihood_ratio() {
+        let noise = NoiseModel::default();
+        let speeds: Vec<f64> = (0..20).map(f64::from).collect();
+        let distances = vec![-0.3; 20];
+        // cuts 8-11 chatter 26 % below the predicted limit, the rest are stable as predicted
+        let chattered: Vec<bool> = (0..20).map(|k| (8..12).contains(&k)).collect();
+        let items = labels(&distances, &chattered);
+        let scan = Scan::new(&speeds, &items, &noise);
+        let (score, a, b) = scan.largest(&chattered, &[0.0; 20]);
+        assert_eq!((a, b), (8, 11));
+        // the best offset moves the boundary below the cuts: four labels go from about the
+        // lapse (1 %) to nearly certain, a ratio of at least 4 ln 50
+        assert!(score > 4.0 * 50f64.ln(), "{score}");
+        // the labels as predicted: an offset gains almost nothing
+        let agreeing = vec![false; 20];
+        let (score, _, _) = scan.largest(&agreeing, &[0.0; 20]);
+        assert!((0.0..0.01).contains(&score), "{score}");
+    }
+
+    #[test]
+    fn residual_bands_score_the_gaussian_ratio_of_their_mean() {
+        let noise = NoiseModel::default();
+        let speeds: Vec<f64> = (0..10).map(f64::from).collect();
+        let items: Vec<Item> = (0..10)
+            .map(|_| Item::Residual { kind: 1, z: 0.0 })
+            .collect();
+        let scan = Scan::new(&speeds, &items, &noise);
+        let mut z = vec![0.0; 10];
+        z[2..5].copy_from_slice(&[2.0, 2.0, 2.0]);
+        let (score, a, b) = scan.largest(&[false; 10], &z);
+        assert_eq!((a, b), (2, 4));
+        // (sum z)^2 / (2 n) = 36 / 6
+        assert!((score - 6.0).abs() < 1e-12, "{score}");
+        // residuals are clipped to the global check's outlier cap
+        assert!((clip(100.0) - OUTLIER_CAP.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bands_start_and_end_between_distinct_speeds_and_hold_at_most_half() {
+        let noise = NoiseModel::default();
         let speeds = [1.0, 2.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
-        let values = [0.0, 3.0, 3.0, 3.0, 0.0, 0.0, 0.0, 0.0];
-        let (score, a, b) = largest_band(&speeds, &values);
-        assert_eq!((a, b), (1, 3));
-        assert!((score - 9.0 / 3f64.sqrt()).abs() < 1e-12);
+        let items: Vec<Item> = (0..8).map(|_| Item::Residual { kind: 0, z: 0.0 }).collect();
+        let scan = Scan::new(&speeds, &items, &noise);
+        assert!(scan.bands.iter().all(|&(a, end)| {
+            end - a >= MIN_BAND
+                && 2 * (end - a) <= 8
+                && (a == 0 || speeds[a] != speeds[a - 1])
+                && (end == 8 || speeds[end] != speeds[end - 1])
+        }));
+        assert!(!scan.bands.iter().any(|&(a, _)| a == 2));
         // too few observations for any band
-        assert_eq!(
-            largest_band(&speeds[..5], &values[..5]).0,
-            f64::NEG_INFINITY
-        );
+        let few = Scan::new(&speeds[..5], &items[..5], &noise);
+        assert!(few.bands.is_empty());
     }
 }
