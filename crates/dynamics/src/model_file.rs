@@ -130,6 +130,10 @@ pub struct OperationFile {
     /// absent: even pitch.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch_deg: Option<Vec<f64>>,
+    /// Milling (optional): the radial runout of each tooth (micrometres, one per tooth, each
+    /// >= 0; [`crate::Milling::with_runout_um`]); used by the time-domain simulator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runout_um: Option<Vec<f64>>,
     /// Turning: workpiece diameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub workpiece_diameter_mm: Option<f64>,
@@ -293,6 +297,7 @@ impl OperationFile {
                     Milling::new(teeth as usize, r, direction, d.map(|d| d * 1e-3), None)?
                         .with_helix_deg(self.helix_deg.as_ref().map(HelixDeg::as_slice))?
                         .with_axial_slices(slices)?
+                        .with_runout_um(self.runout_um.as_deref())?
                         .with_pitch_deg(self.pitch_deg.as_deref())?,
                 ))
             }
@@ -304,6 +309,7 @@ impl OperationFile {
                     (self.tool_diameter_mm.is_some(), "tool_diameter_mm"),
                     (self.helix_deg.is_some(), "helix_deg"),
                     (self.axial_slices.is_some(), "axial_slices"),
+                    (self.runout_um.is_some(), "runout_um"),
                     (self.pitch_deg.is_some(), "pitch_deg"),
                 ] {
                     if set {
@@ -597,6 +603,7 @@ impl ModelFile {
                     None => m.helix_rad().map(|h| HelixDeg::One(h.to_degrees())),
                 },
                 axial_slices: m.axial_slices().map(|s| s as i64),
+                runout_um: m.runout_um(),
                 pitch_deg: m.pitch_deg(),
                 workpiece_diameter_mm: None,
             },
@@ -608,6 +615,7 @@ impl ModelFile {
                 tool_diameter_mm: None,
                 helix_deg: None,
                 axial_slices: None,
+                runout_um: None,
                 pitch_deg: None,
                 workpiece_diameter_mm: t.workpiece_diameter_m().map(|d| d * 1e3),
             },

@@ -64,6 +64,8 @@ pub struct Milling {
     helix_per_tooth_rad: Option<Vec<f64>>,
     /// Axial slices of the depth of cut of a helical cutter; `None`: [`DEFAULT_AXIAL_SLICES`].
     axial_slices: Option<usize>,
+    /// Radial runout (m) of each tooth, `None`: none.
+    runout_m: Option<Vec<f64>>,
 }
 
 /// The axial slices of a helical cutter's depth when the model gives none (`axial_slices`).
@@ -137,6 +139,7 @@ impl Milling {
             pitch_rad: None,
             helix_per_tooth_rad: None,
             axial_slices: None,
+            runout_m: None,
         };
         out.require_diameter_for_helix()?;
         Ok(out)
@@ -196,6 +199,57 @@ impl Milling {
             axial_slices,
             ..self
         })
+    }
+
+    /// The same cutter with the radial runout `runout_um` (micrometres, one per tooth, each
+    /// >= 0: how far each tooth's edge stands out beyond the nominal radius); `None` is none.
+    /// Runout is a forced motion: it changes the chips and the surface (the time-domain
+    /// simulator models it) but not the linear stability of the cut. Errors name
+    /// `operation.runout_um`.
+    pub fn with_runout_um(self, runout_um: Option<&[f64]>) -> Result<Self> {
+        let Some(r) = runout_um else {
+            return Ok(Self {
+                runout_m: None,
+                ..self
+            });
+        };
+        if r.len() != self.teeth {
+            return Err(DynamicsError::invalid(
+                "operation.runout_um",
+                format!(
+                    "{} values: expected one radial offset per tooth ({})",
+                    r.len(),
+                    self.teeth
+                ),
+            ));
+        }
+        if let Some((j, v)) = r
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+        {
+            return Err(DynamicsError::value(
+                format!("operation.runout_um[{j}]"),
+                *v,
+                "a radial runout >= 0 micrometres (how far the tooth stands out)",
+            ));
+        }
+        Ok(Self {
+            runout_m: Some(r.iter().map(|v| v * 1e-6).collect()),
+            ..self
+        })
+    }
+
+    /// Tooth j's radial runout (m; `j` modulo N), 0 without runout.
+    pub fn tooth_runout_m(&self, j: usize) -> f64 {
+        self.runout_m.as_ref().map_or(0.0, |r| r[j % self.teeth])
+    }
+
+    /// The radial runout per tooth in micrometres as given (`None`: none).
+    pub fn runout_um(&self) -> Option<Vec<f64>> {
+        self.runout_m
+            .as_ref()
+            .map(|r| r.iter().map(|v| v * 1e6).collect())
     }
 
     /// A helical cutter needs its radius: the error names `operation.tool_diameter_mm`.
@@ -402,6 +456,7 @@ impl Milling {
             pitch_rad: self.pitch_rad.clone(),
             helix_per_tooth_rad: self.helix_per_tooth_rad.clone(),
             axial_slices: self.axial_slices,
+            runout_m: self.runout_m.clone(),
             ..Self::new(
                 self.teeth,
                 radial_immersion,

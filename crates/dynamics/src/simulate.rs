@@ -207,6 +207,66 @@ pub const MAX_SURFACE_SAMPLES: usize = 50_000_000;
 /// nearest step (an error of at most half a step in each pitch).
 pub const PITCH_GRID_SEARCH: usize = 1000;
 
+/// One cutting edge element of the simulation: a tooth, or one axial slice of a helical tooth.
+struct Element {
+    /// The tooth (its runout and static chip).
+    tooth: usize,
+    /// The surface ring it cuts (its axial slice; 0 for a straight cutter).
+    ring: usize,
+    /// Its angle at step 0 in steps of the revolution.
+    offset: usize,
+    /// The fraction of the depth it cuts.
+    weight: f64,
+}
+
+/// The elements of `model` at `depth_m` on a revolution of `steps_per_rev` steps: each tooth at
+/// `offset_steps` with the whole depth, or for a helical cutter each of its axial slices
+/// ([`crate::Milling::cutting_edges`]) with its own surface ring, its tooth's offset less the
+/// slice's helix lag z tan(beta_j) / R rounded to the nearest step (an angle error of at most
+/// half a step, 1 / (2 R) of a turn) and its share of the depth.
+fn edge_elements(
+    model: &ModalModel,
+    depth_m: f64,
+    offset_steps: &[usize],
+    steps_per_rev: usize,
+) -> Vec<Element> {
+    let straight = || {
+        offset_steps
+            .iter()
+            .enumerate()
+            .map(|(j, &offset)| Element {
+                tooth: j,
+                ring: 0,
+                offset,
+                weight: 1.0,
+            })
+            .collect()
+    };
+    let Operation::Milling(m) = model.operation() else {
+        return straight();
+    };
+    if !m.is_helical() {
+        return straight();
+    }
+    let edges = m.cutting_edges(depth_m);
+    let slices = edges.len() / m.teeth();
+    let r = steps_per_rev as f64;
+    edges
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let lag = m.tooth_offset_rad(e.tooth) - e.lead_rad;
+            let lag_steps = ((lag / (2.0 * PI) * r).round() as usize) % steps_per_rev;
+            Element {
+                tooth: e.tooth,
+                ring: i % slices,
+                offset: (offset_steps[e.tooth] + steps_per_rev - lag_steps) % steps_per_rev,
+                weight: e.weight,
+            }
+        })
+        .collect()
+}
+
 /// Per mode: transition (row-major 2x2), input vector of the held force, input vector of the
 /// force's change over the step, shape, omega_n, zeta_n.
 struct ModeStep {
@@ -317,7 +377,13 @@ pub fn simulate_with_observer(
             .collect(),
         _ => vec![1.0; edges],
     };
-    let surface_samples = steps_per_delay.saturating_mul(edges);
+    let elements = edge_elements(&model, settings.depth_m, &offset_steps, steps_per_delay * edges);
+    let rings = elements.iter().map(|e| e.ring + 1).max().unwrap_or(1);
+    let runout: Vec<f64> = match model.operation() {
+        Operation::Milling(m) => (0..edges).map(|j| m.tooth_runout_m(j)).collect(),
+        Operation::Turning(_) => vec![0.0],
+    };
+    let surface_samples = steps_per_delay.saturating_mul(edges).saturating_mul(rings);
     if surface_samples > MAX_SURFACE_SAMPLES {
         // steps per delay grow as 1 / speed: the speed at which the surface fits the cap
         let lowest = settings.speed_rpm * surface_samples as f64 / MAX_SURFACE_SAMPLES as f64;
@@ -383,9 +449,9 @@ pub fn simulate_with_observer(
         None => (0.0, 0.0),
     };
     // each tooth's angle in steps, (k + offset_steps[j]) mod steps_per_rev
-    let mut tooth_index = vec![0usize; edges];
+    let mut tooth_index = vec![0usize; elements.len()];
     // (sin, cos) of each tooth angle, rotated by the step angle and recomputed every delay
-    let mut tooth_sc = vec![[0.0f64, 1.0f64]; edges];
+    let mut tooth_sc = vec![[0.0f64, 1.0f64]; elements.len()];
     // force direction u of a milling edge whose chip direction is (sin phi, cos phi)
     let milling_force_direction = |[s, c]: [f64; 2]| [kt * c + kn * s, -kt * s + kn * c];
     let omega_spindle = 2.0 * PI * settings.speed_rpm / 60.0;
@@ -394,15 +460,15 @@ pub fn simulate_with_observer(
     let cv = model.process_damping_per_width(settings.speed_rpm);
     // surface ring buffer: the surface last left at each angle index of one revolution (steps
     // per delay times edges values; in turning the revolution is the delay)
-    let mut surface = vec![f64::NAN; steps_per_delay * edges];
+    let mut surface = vec![f64::NAN; steps_per_rev * rings];
     // each edge's angle index at this step, and the surface there as the edge ahead left it,
     // read before any edge overwrites it
-    let mut angle_index = vec![0usize; edges];
-    let mut previous_slot = vec![f64::NAN; edges];
+    let mut angle_index = vec![0usize; elements.len()];
+    let mut previous_slot = vec![f64::NAN; elements.len()];
     // per edge, the chip and the ungated force of the previous step (for the extrapolation)
-    let mut previous_chip = vec![0.0f64; edges];
-    let mut previous_edge_force = vec![[0.0f64; 2]; edges];
-    let mut previous_in_cut = vec![false; edges];
+    let mut previous_chip = vec![0.0f64; elements.len()];
+    let mut previous_edge_force = vec![[0.0f64; 2]; elements.len()];
+    let mut previous_in_cut = vec![false; elements.len()];
     let harmonic = |t: f64| -> f64 {
         (1..=4)
             .map(|k| (k as f64 * omega_spindle * t + 0.7 * k as f64).cos() / k as f64)
@@ -439,7 +505,7 @@ pub fn simulate_with_observer(
         if milling.is_some() {
             if step % steps_per_delay == 0 {
                 for (j, (sc, index)) in tooth_sc.iter_mut().zip(&mut tooth_index).enumerate() {
-                    *index = (step + offset_steps[j]) % steps_per_rev;
+                    *index = (step + elements[j].offset) % steps_per_rev;
                     let (s, c) = (*index as f64 * step_angle).sin_cos();
                     *sc = [s, c];
                 }
@@ -457,10 +523,14 @@ pub fn simulate_with_observer(
         } else {
             angle_index[0] = slot;
         }
-        for (previous, &index) in previous_slot.iter_mut().zip(&angle_index) {
-            *previous = surface[index];
+        for ((previous, &index), element) in
+            previous_slot.iter_mut().zip(&angle_index).zip(&elements)
+        {
+            *previous = surface[element.ring * steps_per_rev + index];
         }
-        for j in 0..edges {
+        for (j, element) in elements.iter().enumerate() {
+            let b = b * element.weight;
+            let ring = element.ring * steps_per_rev;
             // chip direction n, force direction u and the part [a, z] of the step in the cut
             let (n_dir, u, in_cut, (a, z)) = match milling {
                 None => ([1.0, 0.0], [kn, kt], true, (0.0, 1.0)),
@@ -479,12 +549,13 @@ pub fn simulate_with_observer(
                 }
             };
             // edge position along n including the rigid feed motion
-            let e = n_dir[0] * (feed_speed * t - x[0]) - n_dir[1] * x[1];
+            // (and the tooth's runout, how far it stands out along n)
+            let e = n_dir[0] * (feed_speed * t - x[0]) - n_dir[1] * x[1] + runout[element.tooth];
             // the surface at this angle was left one pitch ago by the next edge (milling) or one
             // revolution ago by the same edge (turning)
             let previous = previous_slot[j];
             let s_prev = if previous.is_nan() {
-                e - settings.feed_per_tooth_m * chip_scale[j] * n_dir[0] // rigid first pass
+                e - settings.feed_per_tooth_m * chip_scale[element.tooth] * n_dir[0] // rigid first pass
             } else {
                 previous
             };
@@ -519,10 +590,11 @@ pub fn simulate_with_observer(
                         }
                     };
                     let x_end = [x[0] + v[0] * h, x[1] + v[1] * h];
-                    let e_end = n_end[0] * (feed_speed * (t + h) - x_end[0]) - n_end[1] * x_end[1];
-                    let s_next = surface[(angle_index[j] + 1) % steps_per_rev];
+                    let e_end = n_end[0] * (feed_speed * (t + h) - x_end[0]) - n_end[1] * x_end[1]
+                        + runout[element.tooth];
+                    let s_next = surface[ring + (angle_index[j] + 1) % steps_per_rev];
                     let chip_end = if s_next.is_nan() {
-                        settings.feed_per_tooth_m * chip_scale[j] * n_end[0]
+                        settings.feed_per_tooth_m * chip_scale[element.tooth] * n_end[0]
                     } else {
                         e_end - s_next
                     };
@@ -598,7 +670,7 @@ pub fn simulate_with_observer(
                     new_surface = s_prev.min(e);
                 }
             }
-            surface[angle_index[j]] = new_surface;
+            surface[ring + angle_index[j]] = new_surface;
         }
         if settings.harmonic_force_n > 0.0 {
             // known in closed form: its values at both ends of the step
