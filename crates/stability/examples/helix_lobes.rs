@@ -3,12 +3,18 @@
 //! islands of low-immersion helical milling (Zatarain et al. 2006; Insperger et al. 2003) on the
 //! single-DOF benchmark (Insperger & Stépán 2004) at 5 % down milling, 2 teeth, a 6 mm tool with
 //! a 30 deg helix: a depth map of |mu| at 17 000-18 500 rpm ('.' stable, '#' unstable) for the
-//! straight and the helical cutter.
+//! straight and the helical cutter. Last, the time of a 200-speed SDM lobe diagram of seed
+//! 001's mill with four pitch delays (70-110-70-110 deg) and a 30 deg helix in 20 slices.
 //! `cargo run --release -p chatter-stability --example helix_lobes`.
 
 use chatter_dynamics::{Milling, ModalModel, Operation, examples};
 use chatter_stability::StabilitySolver;
+use chatter_progress::Silent;
+use chatter_stability::boundary::BoundaryOptions;
 use chatter_stability::monodromy::Discretization;
+use chatter_stability::prepared::Method;
+use chatter_stability::speed_grid::default_speeds_rpm;
+use std::time::Instant;
 
 /// `model` with a `diameter_mm` tool of helix `helix_deg` cut in `slices` axial slices.
 fn helical(model: &ModalModel, diameter_mm: f64, helix_deg: f64, slices: usize) -> ModalModel {
@@ -22,8 +28,9 @@ fn helical(model: &ModalModel, diameter_mm: f64, helix_deg: f64, slices: usize) 
         Some(diameter_mm * 1e-3),
         None,
     )
-    .and_then(|m| m.with_helix_deg(Some(&[helix_deg])))
-    .and_then(|m| m.with_axial_slices(Some(slices)))
+    .and_then(|h| h.with_helix_deg(Some(&[helix_deg])))
+    .and_then(|h| h.with_axial_slices(Some(slices)))
+    .and_then(|h| h.with_pitch_deg(m.pitch_deg().as_deref()))
     .expect("a valid helical cutter");
     model
         .with_operation(Operation::Milling(milling))
@@ -91,5 +98,44 @@ fn main() {
                 .collect();
             println!("{rpm:7.0} {line}");
         }
+    }
+    let mill = examples::schmitz_2023_milling();
+    let Operation::Milling(m) = mill.operation() else {
+        unreachable!("a milling model")
+    };
+    let pitched = mill
+        .with_operation(Operation::Milling(
+            m.clone()
+                .with_pitch_deg(Some(&[70.0, 110.0, 70.0, 110.0]))
+                .expect("valid pitches"),
+        ))
+        .expect("a valid model");
+    let speeds = default_speeds_rpm(&mill);
+    println!(
+        "\n200-speed SDM lobe diagrams of 001 ({:.0}-{:.0} rpm)",
+        speeds[0],
+        speeds[speeds.len() - 1]
+    );
+    for (label, model) in [
+        ("70-110-70-110, straight", pitched.clone()),
+        (
+            "70-110-70-110, 30 deg helix, 20 slices",
+            helical(&pitched, 12.7, 30.0, 20),
+        ),
+    ] {
+        let start = Instant::now();
+        let lobes = Method::Sdm
+            .prepare(&model, &BoundaryOptions::default())
+            .and_then(|s| s.lobes(&speeds, &Silent))
+            .expect("lobes");
+        let lowest = lobes
+            .iter()
+            .map(|p| p.depth_m)
+            .fold(f64::INFINITY, f64::min);
+        println!(
+            "{label}: {:.2} s, lowest limit {:.4} mm",
+            start.elapsed().as_secs_f64(),
+            lowest * 1e3
+        );
     }
 }

@@ -60,3 +60,58 @@ pub(crate) fn edge_segments(
         })
         .collect()
 }
+
+/// Grid of one principal period tau at `speed_rpm` for a helical cutter's elements `edges`: cut
+/// only where a tooth's engagement begins and ends, the entry of its leading slice and the exit
+/// of its trailing one (the envelope [entry + lag_min, exit + lag_max] of the tooth angle), so
+/// the steps do not crowd at every slice's entry and exit; inside the envelope the slices' entries
+/// and exits fall inside steps, whose coefficients are sampled there ([`crate::step::StepPlan`]),
+/// and a step where no slice cuts has zero coefficients. A segment cuts when its middle lies in
+/// some tooth's envelope.
+pub(crate) fn envelope_segments(
+    model: &ModalModel,
+    speed_rpm: f64,
+    tau: f64,
+    edges: &[CuttingEdge],
+) -> Vec<(f64, f64, bool)> {
+    let Operation::Milling(m) = model.operation() else {
+        return edge_segments(model, speed_rpm, tau, edges);
+    };
+    let omega = 2.0 * PI * speed_rpm / 60.0;
+    let (entry, exit) = m.entry_exit_rad();
+    // per tooth: its lead without lag and the smallest and largest lag of its slices
+    let envelopes: Vec<(f64, f64, f64)> = (0..m.teeth())
+        .filter_map(|j| {
+            let lags = edges
+                .iter()
+                .filter(|e| e.tooth == j)
+                .map(|e| m.tooth_offset_rad(j) - e.lead_rad);
+            let (lo, hi) = lags.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), l| {
+                (lo.min(l), hi.max(l))
+            });
+            lo.is_finite().then_some((m.tooth_offset_rad(j), lo, hi))
+        })
+        .collect();
+    let mut cuts = vec![0.0, tau];
+    for &(offset, lo, hi) in &envelopes {
+        for angle in [entry + lo, exit + hi] {
+            let t = ((angle - offset).rem_euclid(2.0 * PI) / omega).rem_euclid(tau);
+            if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
+                cuts.push(t);
+            }
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
+    cuts.windows(2)
+        .map(|w| {
+            let mid = 0.5 * (w[0] + w[1]);
+            let cutting = envelopes.iter().any(|&(offset, lo, hi)| {
+                let span = exit + hi - (entry + lo);
+                span >= 2.0 * PI
+                    || (omega * mid + offset - (entry + lo)).rem_euclid(2.0 * PI) <= span
+            });
+            (w[0], w[1], cutting)
+        })
+        .collect()
+}

@@ -12,7 +12,7 @@
 //! bit, as one built from scratch.
 
 use crate::error::{Result, StabilityError, check_condition};
-use crate::grid::{edge_segments, segments};
+use crate::grid::{envelope_segments, segments};
 use crate::monodromy::{Discretization, Interp, Monodromy, Scheme, Step, Tap, principal_period};
 use chatter_dynamics::{CuttingEdge, ModalModel, Operation};
 use nalgebra::{DMatrix, Matrix2};
@@ -444,7 +444,7 @@ impl StepPlan {
 
     /// The program of a helical cutter at `depth_m`: the cutting edge elements at that depth
     /// ([`chatter_dynamics::Milling::cutting_edges`]), grouped by delay into the delayed inputs,
-    /// the grid cut at every element's entry and exit.
+    /// the grid cut where each tooth's engagement begins and ends (the crate's `grid` module).
     fn helical_at_depth(
         model: &ModalModel,
         speed_rpm: f64,
@@ -471,7 +471,7 @@ impl StepPlan {
             });
         }
         let (tau, _) = principal_period(model, speed_rpm);
-        let segs = edge_segments(model, speed_rpm, tau, &edges);
+        let segs = envelope_segments(model, speed_rpm, tau, &edges);
         let periodic = Periodic {
             model,
             speed_rpm,
@@ -1124,15 +1124,16 @@ fn variable_pitch_segments(
         for &t in &samples {
             periodic.push(equivalent(t), &mut unit);
         }
-        let mid = equivalent(0.5 * (start + end));
         let mut teeth = Vec::new();
         for j in 0..periodic.inputs() {
-            if periodic.input_matrix(j, mid).abs().max() == 0.0 {
-                continue;
-            }
+            // an input that cuts nowhere the steps sample it has no delayed term here (on a
+            // straight cutter's segment a tooth cuts at every sample or at none)
             let mut tooth_unit = Vec::new();
             for &t in &samples {
                 periodic.push_tooth(j, equivalent(t), &mut tooth_unit);
+            }
+            if tooth_unit.iter().all(|w| *w == 0.0) {
+                continue;
             }
             let tau = periodic.delay_rad(j) / omega;
             let taps = (0..k)
