@@ -130,8 +130,8 @@ pub struct OperationFile {
     /// absent: even pitch.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch_deg: Option<Vec<f64>>,
-    /// Milling (optional): the radial runout of each tooth (micrometres, one per tooth, each
-    /// >= 0; [`crate::Milling::with_runout_um`]); used by the time-domain simulator.
+    /// Milling (optional): the radial runout of each tooth (micrometres, one per tooth, none
+    /// negative; [`crate::Milling::with_runout_um`]); used by the time-domain simulator.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runout_um: Option<Vec<f64>>,
     /// Turning: workpiece diameter.

@@ -201,8 +201,8 @@ impl Milling {
         })
     }
 
-    /// The same cutter with the radial runout `runout_um` (micrometres, one per tooth, each
-    /// >= 0: how far each tooth's edge stands out beyond the nominal radius); `None` is none.
+    /// The same cutter with the radial runout `runout_um` (micrometres, one per tooth, none
+    /// negative: how far each tooth's edge stands out beyond the nominal radius); `None` is none.
     /// Runout is a forced motion: it changes the chips and the surface (the time-domain
     /// simulator models it) but not the linear stability of the cut. Errors name
     /// `operation.runout_um`.

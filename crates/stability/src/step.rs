@@ -458,7 +458,7 @@ impl StepPlan {
             });
         };
         let edges = m.cutting_edges(depth_m);
-        if let Some(e) = edges.iter().find(|e| !(e.delay_rad > 0.0)) {
+        if let Some(e) = edges.iter().find(|e| e.delay_rad.is_nan() || e.delay_rad <= 0.0) {
             return Err(StabilityError::Unsupported {
                 method: method.scheme.name(),
                 reason: format!(
