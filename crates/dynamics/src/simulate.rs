@@ -25,6 +25,14 @@
 //! itself. A tooth's radial runout r_j (`operation.runout_um`) moves its edge out along n:
 //! e_j = n . (x + feed) + r_j, so its chip is f + r_j - r_{j+1} in a rigid cut.
 //!
+//! # Spindle-speed variation
+//! Under Omega(t) = Omega_0 (1 + A sin(2 pi r f_0 t)) (`speed_variation`) the tooth angle is
+//! Omega_0 s(t) ([`TimeMap`]); the simulator steps uniformly in s, so the angles stay on the
+//! grid and the surface one pitch back is where it was (the time-varying delay comes out of the
+//! angle grid), and each step lasts t(s + h) - t(s) of true time, with the modal transition of
+//! that duration. The outputs are interpolated linearly onto uniform true times before the
+//! resampler. The static chip is per tooth (feed proportional to the spindle angle).
+//!
 //! # Forcing and integration
 //! The internal step depends on the dynamics only, never on the output rate
 //! ([`internal_step`]): a whole number of steps per delay (so the surface one delay ago lies on
@@ -80,6 +88,46 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use std::f64::consts::PI;
 
+/// Tooth angles under a sinusoidal spindle-speed variation, Omega(t) = Omega_0 (1 + A sin(w_m t))
+/// (Insperger & Stépán 2004; Sastry, Kapoor & DeVor 2002): the angle is Omega_0 s(t) with the
+/// equivalent constant-speed time s(t) = t - (A / w_m) (cos(w_m t) - 1), increasing for A < 1
+/// and equal to t at every whole modulation period. The simulator steps uniformly in s (so the
+/// tooth angles stay on its grid) and the discretizations sample the coefficients at s(t).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeMap {
+    amplitude: f64,
+    omega_m: f64,
+}
+
+impl TimeMap {
+    /// The map of relative amplitude `amplitude` A in [0, 1) at modulation frequency
+    /// `omega_m_rad_s` w_m > 0 (callers validate both).
+    pub fn new(amplitude: f64, omega_m_rad_s: f64) -> Self {
+        Self {
+            amplitude,
+            omega_m: omega_m_rad_s,
+        }
+    }
+
+    /// s(t).
+    pub fn equivalent(&self, t: f64) -> f64 {
+        t - self.amplitude / self.omega_m * ((self.omega_m * t).cos() - 1.0)
+    }
+
+    /// The t with s(t) = `s` (Newton from t = s; s' = 1 + A sin(w_m t) >= 1 - A > 0).
+    pub fn inverse(&self, s: f64) -> f64 {
+        let mut t = s;
+        for _ in 0..100 {
+            let step = (self.equivalent(t) - s) / (1.0 + self.amplitude * (self.omega_m * t).sin());
+            t -= step;
+            if step.abs() <= 1e-15 * (1.0 + t.abs()) {
+                break;
+            }
+        }
+        t
+    }
+}
+
 /// Which kinematic quantity the output channels hold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Quantity {
@@ -115,6 +163,10 @@ pub struct SimulationSettings {
     pub harmonic_force_n: f64,
     /// Radial immersion override for milling.
     pub radial_immersion: Option<f64>,
+    /// Spindle-speed variation (amplitude ratio A in [0, 1), frequency ratio r > 0): the speed
+    /// is Omega_0 (1 + A sin(2 pi r f_0 t)) about `speed_rpm` = 60 f_0 ([`TimeMap`]). Default
+    /// none.
+    pub speed_variation: Option<(f64, f64)>,
 }
 
 impl SimulationSettings {
@@ -137,6 +189,7 @@ impl SimulationSettings {
             random_force_rms_n: 1.0,
             harmonic_force_n: 0.0,
             radial_immersion: None,
+            speed_variation: None,
         }
     }
 
@@ -153,6 +206,22 @@ impl SimulationSettings {
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(DynamicsError::value(field, v, "a finite value >= 0"));
+            }
+        }
+        if let Some((a, r)) = self.speed_variation {
+            if !(a.is_finite() && (0.0..1.0).contains(&a)) {
+                return Err(DynamicsError::value(
+                    "ssv_amplitude_ratio",
+                    a,
+                    "an amplitude ratio in [0, 1): the speed must stay positive",
+                ));
+            }
+            if !(r.is_finite() && r > 0.0) {
+                return Err(DynamicsError::value(
+                    "ssv_frequency_ratio",
+                    r,
+                    "a modulation frequency over the spindle frequency > 0",
+                ));
             }
         }
         let samples = self.duration_s * self.sample_rate_hz;
@@ -410,7 +479,14 @@ pub fn simulate_with_observer(
     let n_out = (settings.duration_s * settings.sample_rate_hz).floor() as usize;
     let mut resampler = Resampler::<2>::new(h, settings.sample_rate_hz);
     let last_out_s = (n_out.max(1) - 1) as f64 / settings.sample_rate_hz;
-    let total_steps = ((last_out_s + resampler.half_width_s()) / h).ceil() as usize + 2;
+    let end_s = last_out_s + resampler.half_width_s();
+    let end_s = match settings.speed_variation {
+        Some((a, r)) if a > 0.0 => {
+            TimeMap::new(a, 2.0 * PI * r * settings.speed_rpm / 60.0).equivalent(end_s)
+        }
+        _ => end_s,
+    };
+    let total_steps = (end_s / h).ceil() as usize + 2;
     if total_steps > 2_000_000_000 {
         return Err(DynamicsError::value(
             "duration_s",
@@ -466,6 +542,26 @@ pub fn simulate_with_observer(
     let feed_speed = settings.feed_per_tooth_m / tau; // m/s along x (milling) or feed (turning)
     let b = settings.depth_m;
     let cv = model.process_damping_per_width(settings.speed_rpm);
+    // spindle-speed variation: the steps are uniform in the equivalent time s (tooth angles on
+    // the grid), each lasting t(s + h) - t(s) of true time
+    let map = match settings.speed_variation {
+        Some((a, r)) if a > 0.0 => {
+            if cv > 0.0 {
+                return Err(DynamicsError::invalid(
+                    "process_damping",
+                    "with a spindle-speed variation (the cutting speed varies along the cut) \
+                     is not simulated",
+                ));
+            }
+            Some(TimeMap::new(a, 2.0 * PI * r * settings.speed_rpm / 60.0))
+        }
+        _ => None,
+    };
+    let true_time = |s: f64| map.map_or(s, |m| m.inverse(s));
+    let mut modes = modes;
+    // the output at uniform true times, interpolated between the steps of a varied speed
+    let mut last_output: Option<(f64, [f64; 2])> = None;
+    let mut next_output = 0usize;
     // surface ring buffer: the surface last left at each angle index of one revolution (steps
     // per delay times edges values; in turning the revolution is the delay)
     let mut surface = vec![f64::NAN; steps_per_rev * rings];
@@ -496,6 +592,17 @@ pub fn simulate_with_observer(
 
     for step in 0..total_steps {
         let t = step as f64 * h;
+        // the step's true duration under a speed variation (h at constant speed)
+        let dt = match map {
+            Some(_) => {
+                let dt = true_time(t + h) - true_time(t);
+                for md in modes.iter_mut() {
+                    (md.phi, md.held, md.ramp) = mode_transition(md.omega, md.zeta, dt);
+                }
+                dt
+            }
+            None => h,
+        };
         let (mut x, mut v) = ([0.0f64; 2], [0.0f64; 2]);
         for (n, md) in modes.iter().enumerate() {
             x[0] += md.shape[0] * q[n];
@@ -597,7 +704,7 @@ pub fn simulate_with_observer(
                             (n_end, milling_force_direction(n_end))
                         }
                     };
-                    let x_end = [x[0] + v[0] * h, x[1] + v[1] * h];
+                    let x_end = [x[0] + v[0] * dt, x[1] + v[1] * dt];
                     let e_end = n_end[0] * (feed_speed * (t + h) - x_end[0]) - n_end[1] * x_end[1]
                         + runout[element.tooth];
                     let s_next = surface[ring + (angle_index[j] + 1) % steps_per_rev];
@@ -714,7 +821,31 @@ pub fn simulate_with_observer(
                 acc
             }
         };
-        resampler.push(value, &mut out);
+        match map {
+            None => resampler.push(value, &mut out),
+            Some(_) => {
+                // linear interpolation onto the uniform true times n h
+                let now = true_time(t);
+                if let Some((before, previous)) = last_output {
+                    while (next_output as f64) * h <= now {
+                        let at = next_output as f64 * h;
+                        let w = (at - before) / (now - before);
+                        resampler.push(
+                            [
+                                previous[0] + w * (value[0] - previous[0]),
+                                previous[1] + w * (value[1] - previous[1]),
+                            ],
+                            &mut out,
+                        );
+                        next_output += 1;
+                    }
+                } else {
+                    resampler.push(value, &mut out);
+                    next_output = 1;
+                }
+                last_output = Some((now, value));
+            }
+        }
         // the linear force p0 + dp s with the same two moments as the cutting and harmonic
         // forces over the step (p0 = 4 M0 - 6 M1, dp = 12 M1 - 6 M0), plus the held random force
         let held = [
@@ -745,12 +876,17 @@ pub fn simulate_with_observer(
     // once-per-revolution pulses at the output samples nearest each revolution start
     let rev_s = 60.0 / settings.speed_rpm;
     let mut pulse = vec![0.0; n_out];
+    let mut revolutions = 0.0;
     let mut next_rev = 0.0;
     for (k, p) in pulse.iter_mut().enumerate() {
         let ts = k as f64 / settings.sample_rate_hz;
         if ts >= next_rev - 0.5 / settings.sample_rate_hz {
             *p = 1.0;
-            next_rev += rev_s;
+            revolutions += 1.0;
+            next_rev = match map {
+                None => next_rev + rev_s,
+                Some(m) => m.inverse(revolutions * rev_s),
+            };
         }
     }
     let names = model.operation().coordinates();

@@ -14,6 +14,7 @@
 use crate::error::{Result, StabilityError, check_condition};
 use crate::grid::{envelope_segments, segments};
 use crate::monodromy::{Discretization, Interp, Monodromy, Scheme, Step, Tap, principal_period};
+use chatter_dynamics::simulate::TimeMap;
 use chatter_dynamics::{CuttingEdge, ModalModel, Operation};
 use nalgebra::{DMatrix, Matrix2};
 
@@ -857,35 +858,6 @@ fn refuse_helical_process_damping(model: &ModalModel, method: Discretization) ->
     Ok(())
 }
 
-/// Tooth angles under a sinusoidal spindle-speed variation, Omega(t) = Omega_0 (1 + A sin(w_m t))
-/// (Insperger & Stépán 2004; Sastry, Kapoor & DeVor 2002): the angle is Omega_0 s(t) with the
-/// equivalent constant-speed time s(t) = t - (A / w_m) (cos(w_m t) - 1), increasing for A < 1.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct TimeMap {
-    pub(crate) amplitude: f64,
-    pub(crate) omega_m: f64,
-}
-
-impl TimeMap {
-    /// s(t).
-    pub(crate) fn equivalent(&self, t: f64) -> f64 {
-        t - self.amplitude / self.omega_m * ((self.omega_m * t).cos() - 1.0)
-    }
-
-    /// The t with s(t) = `s` (Newton from t = s; s' = 1 + A sin(w_m t) >= 1 - A > 0).
-    pub(crate) fn inverse(&self, s: f64) -> f64 {
-        let mut t = s;
-        for _ in 0..100 {
-            let step = (self.equivalent(t) - s) / (1.0 + self.amplitude * (self.omega_m * t).sin());
-            t -= step;
-            if step.abs() <= 1e-15 * (1.0 + t.abs()) {
-                break;
-            }
-        }
-        t
-    }
-}
-
 impl StepPlan {
     /// The plan of `method` for `model` at the mean speed `speed_rpm` under the spindle-speed
     /// variation of relative amplitude `amplitude_ratio` in (0, 1) at `frequency_ratio` times the
@@ -937,10 +909,7 @@ impl StepPlan {
         let period = q as f64 * tau;
         let revolution = 60.0 / speed_rpm;
         let omega = 2.0 * std::f64::consts::PI / revolution;
-        let map = TimeMap {
-            amplitude: amplitude_ratio,
-            omega_m: 2.0 * std::f64::consts::PI / period,
-        };
+        let map = TimeMap::new(amplitude_ratio, 2.0 * std::f64::consts::PI / period);
         // breakpoints in equivalent time: every entry and exit over the q delays
         let mut cuts = vec![0.0, period];
         if let Operation::Milling(m) = op {
