@@ -28,7 +28,13 @@ fn mill() -> ModalModel {
 
 /// |mu| over the modulation period `period_s` from the simulator's transient (periods 20..80)
 /// and the lost-contact fraction.
-fn simulated(model: &ModalModel, rpm: f64, depth_m: f64, ssv: (f64, f64), period_s: f64) -> (f64, f64) {
+fn simulated(
+    model: &ModalModel,
+    rpm: f64,
+    depth_m: f64,
+    ssv: (f64, f64),
+    period_s: f64,
+) -> (f64, f64) {
     let per_period = 40;
     let mut s = deterministic(rpm, depth_m, 82.0 * period_s, per_period as f64 / period_s);
     s.feed_per_tooth_m = 0.2e-3;
@@ -50,7 +56,9 @@ fn simulated_growth_agrees_with_the_ssv_discretization() {
             variation: SpeedVariation::new(amplitude, 1.0).unwrap(),
         };
         for rpm in [5000.0, 7000.0, 9000.0] {
-            let limit = limiting_depth(&solver, &model, rpm, &options).unwrap().depth_m;
+            let limit = limiting_depth(&solver, &model, rpm, &options)
+                .unwrap()
+                .depth_m;
             let depth = 0.9 * limit;
             let mu = solver.dominant_multiplier(&model, rpm, depth).unwrap();
             let (sim, lost) = simulated(&model, rpm, depth, (amplitude, 1.0), mu.period_s);

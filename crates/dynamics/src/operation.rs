@@ -170,7 +170,11 @@ impl Milling {
                 } else {
                     format!("operation.helix_deg[{j}]")
                 };
-                return Err(DynamicsError::value(field, *v, "an angle in [0, 90) degrees"));
+                return Err(DynamicsError::value(
+                    field,
+                    *v,
+                    "an angle in [0, 90) degrees",
+                ));
             }
         }
         let first = h[0].to_radians();

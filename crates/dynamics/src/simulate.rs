@@ -454,7 +454,12 @@ pub fn simulate_with_observer(
             .collect(),
         _ => vec![1.0; edges],
     };
-    let elements = edge_elements(&model, settings.depth_m, &offset_steps, steps_per_delay * edges);
+    let elements = edge_elements(
+        &model,
+        settings.depth_m,
+        &offset_steps,
+        steps_per_delay * edges,
+    );
     let rings = elements.iter().map(|e| e.ring + 1).max().unwrap_or(1);
     let runout: Vec<f64> = match model.operation() {
         Operation::Milling(m) => (0..edges).map(|j| m.tooth_runout_m(j)).collect(),

@@ -387,7 +387,11 @@ fn helix_slices_and_runout_are_checked_by_name() {
             "operation.helix_deg",
             "one per tooth (4)",
         ),
-        (r#""helix_deg": 30"#, "operation.tool_diameter_mm", "helical"),
+        (
+            r#""helix_deg": 30"#,
+            "operation.tool_diameter_mm",
+            "helical",
+        ),
         (
             r#""tool_diameter_mm": 12, "helix_deg": 30, "axial_slices": 0"#,
             "operation.axial_slices",
@@ -398,7 +402,11 @@ fn helix_slices_and_runout_are_checked_by_name() {
             "operation.runout_um[1]",
             "-2",
         ),
-        (r#""runout_um": [5, 0]"#, "operation.runout_um", "one radial offset per tooth"),
+        (
+            r#""runout_um": [5, 0]"#,
+            "operation.runout_um",
+            "one radial offset per tooth",
+        ),
     ] {
         let err = parse(&with(fields)).err().unwrap().to_string();
         assert!(err.contains(field), "{fields}: {err}");

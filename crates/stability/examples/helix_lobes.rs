@@ -8,8 +8,8 @@
 //! `cargo run --release -p chatter-stability --example helix_lobes`.
 
 use chatter_dynamics::{Milling, ModalModel, Operation, examples};
-use chatter_stability::StabilitySolver;
 use chatter_progress::Silent;
+use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::BoundaryOptions;
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::prepared::Method;

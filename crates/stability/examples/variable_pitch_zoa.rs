@@ -17,7 +17,9 @@ fn with_pitch(model: &ModalModel, pitch_deg: &[f64]) -> ModalModel {
     };
     model
         .with_operation(Operation::Milling(
-            m.clone().with_pitch_deg(Some(pitch_deg)).expect("valid pitches"),
+            m.clone()
+                .with_pitch_deg(Some(pitch_deg))
+                .expect("valid pitches"),
         ))
         .expect("valid model")
 }
@@ -38,7 +40,9 @@ fn main() {
         prepare(&variable, Method::Sdm),
     );
     println!("dP = {dp} deg");
-    println!("rpm,zoa_even_mm,zoa_var_mm,zoa_gain,sdm_even_mm,sdm_var_mm,sdm_gain,zoa_var_chatter_hz");
+    println!(
+        "rpm,zoa_even_mm,zoa_var_mm,zoa_gain,sdm_even_mm,sdm_var_mm,sdm_gain,zoa_var_chatter_hz"
+    );
     let mut speeds: Vec<f64> = (0..=60).map(|i| 4000.0 + 200.0 * i as f64).collect();
     speeds.retain(|s| *s <= 16_000.0);
     for rpm in speeds {

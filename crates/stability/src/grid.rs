@@ -48,13 +48,9 @@ pub(crate) fn edge_segments(
             let mid = 0.5 * (w[0] + w[1]);
             let cutting = match model.operation() {
                 Operation::Turning(_) => model.directional_matrix(mid, speed_rpm).abs().max() > 0.0,
-                Operation::Milling(_) => edges.iter().any(|e| {
-                    model
-                        .edge_directional_matrix(e, mid, speed_rpm)
-                        .abs()
-                        .max()
-                        > 0.0
-                }),
+                Operation::Milling(_) => edges
+                    .iter()
+                    .any(|e| model.edge_directional_matrix(e, mid, speed_rpm).abs().max() > 0.0),
             };
             (w[0], w[1], cutting)
         })

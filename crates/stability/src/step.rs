@@ -459,7 +459,10 @@ impl StepPlan {
             });
         };
         let edges = m.cutting_edges(depth_m);
-        if let Some(e) = edges.iter().find(|e| e.delay_rad.is_nan() || e.delay_rad <= 0.0) {
+        if let Some(e) = edges
+            .iter()
+            .find(|e| e.delay_rad.is_nan() || e.delay_rad <= 0.0)
+        {
             return Err(StabilityError::Unsupported {
                 method: method.scheme.name(),
                 reason: format!(
@@ -508,14 +511,8 @@ impl StepPlan {
         }
         let constant = matches!(model.operation(), Operation::Turning(_));
         if model.operation().has_uneven_teeth() {
-            let segments = variable_pitch_segments(
-                periodic,
-                segs,
-                (m_cut, cutting_time),
-                &a0,
-                method,
-                None,
-            )?;
+            let segments =
+                variable_pitch_segments(periodic, segs, (m_cut, cutting_time), &a0, method, None)?;
             return Ok(Self {
                 modes: n,
                 scheme: method.scheme,
@@ -590,8 +587,7 @@ impl StepPlan {
         check_condition(1.0, depth_m)?;
         if let Some(helical) = &self.helical {
             let (model, speed_rpm, method) = helical.as_ref();
-            return Self::helical_at_depth(model, *speed_rpm, *method, depth_m)?
-                .monodromy(depth_m);
+            return Self::helical_at_depth(model, *speed_rpm, *method, depth_m)?.monodromy(depth_m);
         }
         let n = self.modes;
         let d = 2 * n;
@@ -886,9 +882,10 @@ impl StepPlan {
         if op.is_helical() {
             return Err(StabilityError::Unsupported {
                 method: method.scheme.name(),
-                reason: "operation.helix_deg with a spindle-speed variation is not modelled in the \
+                reason:
+                    "operation.helix_deg with a spindle-speed variation is not modelled in the \
                          discretizations (the time-domain simulator models both)"
-                    .into(),
+                        .into(),
             });
         }
         let delays = op.delays_per_revolution();

@@ -185,7 +185,10 @@ impl OrientedSystem {
                 reason: format!(
                     "operation.pitch_deg = {:?}: one delay per tooth; the lobe table is for even \
                      pitch (the prepared zero-order solver searches a variable pitch)",
-                    pitches_rad.iter().map(|p| p.to_degrees()).collect::<Vec<_>>()
+                    pitches_rad
+                        .iter()
+                        .map(|p| p.to_degrees())
+                        .collect::<Vec<_>>()
                 ),
             });
         }
