@@ -6,7 +6,9 @@
 //! resolution (`Method::Fdm`: extrapolated from m and 2m steps); the multiplier of the 003-type
 //! flexure at 300 rpm with process damping (clustered multipliers, operator dimension 276); the
 //! characteristic roots of turning (the gap diagnosis's turning likelihood) with the seed-000
-//! lathe's two modes and with a third mode (the `extra_mode` class: the LU path of Newton's step).
+//! lathe's two modes and with a third mode (the `extra_mode` class: the LU path of Newton's step);
+//! the 200-speed SDM lobe diagram of seed 001's mill with four pitch delays (70-110-70-110 deg)
+//! and a 30 deg helix in 20 axial slices (issue 33's target: 5 s).
 use chatter_dynamics::examples;
 use chatter_dynamics::{Mode, ModeShape};
 use chatter_progress::Silent;
@@ -99,5 +101,38 @@ fn characteristic_roots(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, zero_order, characteristic_roots);
+fn variable_pitch_helix(c: &mut Criterion) {
+    let mill = examples::schmitz_2023_milling();
+    let chatter_dynamics::Operation::Milling(m) = mill.operation() else {
+        return;
+    };
+    let Ok(milling) = chatter_dynamics::Milling::new(4, 0.2, m.direction(), Some(12.7e-3), None)
+        .and_then(|h| h.with_helix_deg(Some(&[30.0])))
+        .and_then(|h| h.with_axial_slices(Some(20)))
+        .and_then(|h| h.with_pitch_deg(Some(&[70.0, 110.0, 70.0, 110.0])))
+    else {
+        return;
+    };
+    let Ok(model) = mill.with_operation(chatter_dynamics::Operation::Milling(milling)) else {
+        return;
+    };
+    let speeds = chatter_stability::speed_grid::default_speeds_rpm(&mill);
+    let Ok(sdm) = Method::Sdm.prepare(&model, &BoundaryOptions::default()) else {
+        return;
+    };
+    let mut group = c.benchmark_group("lobes");
+    group.sample_size(10);
+    group.bench_function("lobes_200_speeds_sdm_pitch4_helix20", |b| {
+        b.iter(|| sdm.lobes(black_box(&speeds), &Silent))
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench,
+    zero_order,
+    characteristic_roots,
+    variable_pitch_helix
+);
 criterion_main!(benches);

@@ -13,7 +13,7 @@
 //!   which the chip thickness is measured), with V the cutting speed.
 
 use crate::model::{CuttingCoefficients, ModalModel};
-use crate::operation::{Milling, Operation};
+use crate::operation::{CuttingEdge, Milling, Operation};
 use nalgebra::Matrix2;
 use std::f64::consts::PI;
 
@@ -73,6 +73,30 @@ impl ModalModel {
                 let phi = 2.0 * PI * speed_rpm / 60.0 * t_s + m.tooth_offset_rad(tooth);
                 if tooth_in_cut(m, phi) {
                     milling_tooth_matrix(cutting, phi)
+                } else {
+                    Matrix2::zeros()
+                }
+            }
+        }
+    }
+
+    /// A cutting edge element's part of H(t) per unit depth (N/m^2): its weight times the tooth
+    /// directional matrix at phi = Omega t + lead while it cuts, else zero ([`CuttingEdge`],
+    /// [`Milling::cutting_edges`]); its force acts on the displacement difference over its own
+    /// delay. Turning has one edge, K_c times the weight.
+    pub fn edge_directional_matrix(
+        &self,
+        edge: &CuttingEdge,
+        t_s: f64,
+        speed_rpm: f64,
+    ) -> Matrix2<f64> {
+        let cutting = self.cutting();
+        match self.operation() {
+            Operation::Turning(_) => turning_matrix(cutting) * edge.weight,
+            Operation::Milling(m) => {
+                let phi = 2.0 * PI * speed_rpm / 60.0 * t_s + edge.lead_rad;
+                if tooth_in_cut(m, phi) {
+                    milling_tooth_matrix(cutting, phi) * edge.weight
                 } else {
                     Matrix2::zeros()
                 }

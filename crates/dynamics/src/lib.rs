@@ -44,8 +44,10 @@ pub mod sle;
 pub use chatter_modal::{ModalPole, pole};
 pub use error::{DynamicsError, Result};
 pub use model::{CuttingCoefficients, ModalModel, Mode, ModeShape, ResidualTerms};
-pub use model_file::{MeasuredFrfFile, ModelFile};
+pub use model_file::{HelixDeg, MeasuredFrfFile, ModelFile};
 pub use observations::{Cut, CutEvidence, Observations, PoleObservation, SignalRecord};
-pub use operation::{Coordinate, Milling, MillingDirection, Operation, Turning};
+pub use operation::{
+    Coordinate, CuttingEdge, DEFAULT_AXIAL_SLICES, Milling, MillingDirection, Operation, Turning,
+};
 pub use perturbation::{Parameter, ParameterKind, parse_parameters};
 pub use sampled::{ReceptanceMatrix, SampledReceptance};

@@ -143,6 +143,8 @@ pub const TOOL_DIAMETER_MM: Plausible = open_closed(0.0, 2000.0, "a tool diamete
 /// Workpiece diameter (turning).
 pub const WORKPIECE_DIAMETER_MM: Plausible =
     open_closed(0.0, 10_000.0, "a workpiece diameter", "mm");
+/// Most axial slices of a helical cutter's depth (each slice is one delayed input per tooth).
+pub const MAX_AXIAL_SLICES: i64 = 1000;
 /// Helix angle of a milling cutter.
 pub const HELIX_DEG: Plausible = Plausible {
     min: 0.0,

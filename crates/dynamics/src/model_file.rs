@@ -116,14 +116,24 @@ pub struct OperationFile {
     /// Milling: tool diameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_diameter_mm: Option<f64>,
-    /// Milling: helix angle (optional).
+    /// Milling: helix angle (optional), one value or one per tooth (a variable-helix cutter,
+    /// [`crate::Milling::with_helix_deg`]); a helix other than zero spreads the cut along the
+    /// axis and needs `tool_diameter_mm`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub helix_deg: Option<f64>,
+    pub helix_deg: Option<HelixDeg>,
+    /// Milling, helical cutter (optional): the number of axial slices of the depth (>= 1;
+    /// default [`crate::DEFAULT_AXIAL_SLICES`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_slices: Option<i64>,
     /// Milling, variable pitch (optional): the angle (deg) from each tooth to the tooth ahead of
     /// it, one per tooth, each > 0, summing to 360 ([`crate::Milling::with_pitch_deg`]);
     /// absent: even pitch.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch_deg: Option<Vec<f64>>,
+    /// Milling (optional): the radial runout of each tooth (micrometres, one per tooth, none
+    /// negative; [`crate::Milling::with_runout_um`]); used by the time-domain simulator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runout_um: Option<Vec<f64>>,
     /// Turning: workpiece diameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub workpiece_diameter_mm: Option<f64>,
@@ -200,6 +210,26 @@ fn finite_in(field: &str, v: f64) -> Result<f64> {
     }
 }
 
+/// `operation.helix_deg`: one angle for every tooth or one per tooth.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum HelixDeg {
+    /// The same helix on every tooth.
+    One(f64),
+    /// One helix angle per tooth (variable helix).
+    PerTooth(Vec<f64>),
+}
+
+impl HelixDeg {
+    /// The angles as a slice (one value or one per tooth).
+    pub fn as_slice(&self) -> &[f64] {
+        match self {
+            HelixDeg::One(v) => std::slice::from_ref(v),
+            HelixDeg::PerTooth(v) => v,
+        }
+    }
+}
+
 fn opt_f(field: &str, v: Option<f64>) -> Result<Option<f64>> {
     match v {
         Some(x) if !x.is_finite() => Err(DynamicsError::value(field, x, "a finite number")),
@@ -253,16 +283,22 @@ impl OperationFile {
                     }
                 };
                 let d = opt_f("operation.tool_diameter_mm", self.tool_diameter_mm)?;
-                let h = opt_f("operation.helix_deg", self.helix_deg)?;
+                let slices = match self.axial_slices {
+                    Some(s) if s < 1 => {
+                        return Err(DynamicsError::value(
+                            "operation.axial_slices",
+                            s as f64,
+                            "a number of axial slices >= 1",
+                        ));
+                    }
+                    other => other.map(|s| s as usize),
+                };
                 Ok(Operation::Milling(
-                    Milling::new(
-                        teeth as usize,
-                        r,
-                        direction,
-                        d.map(|d| d * 1e-3),
-                        h.map(f64::to_radians),
-                    )?
-                    .with_pitch_deg(self.pitch_deg.as_deref())?,
+                    Milling::new(teeth as usize, r, direction, d.map(|d| d * 1e-3), None)?
+                        .with_helix_deg(self.helix_deg.as_ref().map(HelixDeg::as_slice))?
+                        .with_axial_slices(slices)?
+                        .with_runout_um(self.runout_um.as_deref())?
+                        .with_pitch_deg(self.pitch_deg.as_deref())?,
                 ))
             }
             "turning" => {
@@ -272,6 +308,8 @@ impl OperationFile {
                     (self.direction.is_some(), "direction"),
                     (self.tool_diameter_mm.is_some(), "tool_diameter_mm"),
                     (self.helix_deg.is_some(), "helix_deg"),
+                    (self.axial_slices.is_some(), "axial_slices"),
+                    (self.runout_um.is_some(), "runout_um"),
                     (self.pitch_deg.is_some(), "pitch_deg"),
                 ] {
                     if set {
@@ -390,7 +428,28 @@ impl OperationFile {
         }
         limits::TOOL_DIAMETER_MM
             .check_optional("operation.tool_diameter_mm", self.tool_diameter_mm)?;
-        limits::HELIX_DEG.check_optional("operation.helix_deg", self.helix_deg)?;
+        if let Some(h) = &self.helix_deg {
+            let h = h.as_slice();
+            for (j, v) in h.iter().enumerate() {
+                let field = if h.len() == 1 {
+                    "operation.helix_deg".to_string()
+                } else {
+                    format!("operation.helix_deg[{j}]")
+                };
+                limits::HELIX_DEG.check(field, *v)?;
+            }
+        }
+        if let Some(s) = self.axial_slices
+            && !(1..=limits::MAX_AXIAL_SLICES).contains(&s)
+        {
+            return Err(DynamicsError::invalid(
+                "operation.axial_slices",
+                format!(
+                    "{s}: expected a number of axial slices from 1 to {}",
+                    limits::MAX_AXIAL_SLICES
+                ),
+            ));
+        }
         limits::WORKPIECE_DIAMETER_MM.check_optional(
             "operation.workpiece_diameter_mm",
             self.workpiece_diameter_mm,
@@ -539,7 +598,12 @@ impl ModelFile {
                     .into(),
                 ),
                 tool_diameter_mm: m.tool_diameter_m().map(|d| d * 1e3),
-                helix_deg: m.helix_rad().map(f64::to_degrees),
+                helix_deg: match m.helix_per_tooth_deg() {
+                    Some(h) => Some(HelixDeg::PerTooth(h)),
+                    None => m.helix_rad().map(|h| HelixDeg::One(h.to_degrees())),
+                },
+                axial_slices: m.axial_slices().map(|s| s as i64),
+                runout_um: m.runout_um(),
                 pitch_deg: m.pitch_deg(),
                 workpiece_diameter_mm: None,
             },
@@ -550,6 +614,8 @@ impl ModelFile {
                 direction: None,
                 tool_diameter_mm: None,
                 helix_deg: None,
+                axial_slices: None,
+                runout_um: None,
                 pitch_deg: None,
                 workpiece_diameter_mm: t.workpiece_diameter_m().map(|d| d * 1e3),
             },

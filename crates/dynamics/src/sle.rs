@@ -120,6 +120,13 @@ pub fn surface_location_error(
             ),
         ));
     }
+    if milling.is_helical() {
+        return Err(DynamicsError::invalid(
+            "operation.helix_deg",
+            "a helical cutter's force spreads along the axis; the surface location error here is \
+             for a straight cutter",
+        ));
+    }
     if model.process_damping_n_per_m().is_some_and(|c| c > 0.0) {
         return Err(DynamicsError::invalid(
             "process_damping",

@@ -341,3 +341,75 @@ fn pitch_deg_is_checked_by_name() {
         assert!(err.contains(expected), "{pitch}: {err}");
     }
 }
+
+/// `operation.helix_deg` (one value or one per tooth, in [0, 90)), `operation.axial_slices`
+/// (>= 1) and `operation.runout_um` (one per tooth, each >= 0): errors name the field and echo
+/// the value; a helix needs the tool diameter.
+#[test]
+fn helix_slices_and_runout_are_checked_by_name() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/schmitz2023_milling_model.json"
+    ))
+    .unwrap();
+    let with = |fields: &str| {
+        text.replacen(
+            "\"kind\": \"milling\"",
+            &format!("\"kind\": \"milling\", {fields}"),
+            1,
+        )
+    };
+    let origin = std::path::Path::new("model.json");
+    let parse = |t: &str| chatter_dynamics::ModalModel::from_json_str(t, origin);
+    let ok = parse(&with(
+        r#""tool_diameter_mm": 12, "helix_deg": [30, 35, 30, 35], "axial_slices": 8, "runout_um": [5, 0, 0, 0]"#,
+    ))
+    .unwrap();
+    assert!(ok.operation().is_helical() && ok.operation().has_uneven_teeth());
+    let round_trip = chatter_dynamics::model_file::ModelFile::from_model(&ok);
+    let again = parse(&serde_json::to_string(&round_trip).unwrap()).unwrap();
+    assert_eq!(again.operation(), ok.operation());
+    let uniform = parse(&with(r#""tool_diameter_mm": 12, "helix_deg": 30"#)).unwrap();
+    assert!(uniform.operation().is_helical() && !uniform.operation().has_uneven_teeth());
+    for (fields, field, expected) in [
+        (
+            r#""tool_diameter_mm": 12, "helix_deg": 95"#,
+            "operation.helix_deg",
+            "95",
+        ),
+        (
+            r#""tool_diameter_mm": 12, "helix_deg": [30, 30, -5, 30]"#,
+            "operation.helix_deg[2]",
+            "-5",
+        ),
+        (
+            r#""tool_diameter_mm": 12, "helix_deg": [30, 30]"#,
+            "operation.helix_deg",
+            "one per tooth (4)",
+        ),
+        (
+            r#""helix_deg": 30"#,
+            "operation.tool_diameter_mm",
+            "helical",
+        ),
+        (
+            r#""tool_diameter_mm": 12, "helix_deg": 30, "axial_slices": 0"#,
+            "operation.axial_slices",
+            "0",
+        ),
+        (
+            r#""runout_um": [5, -2, 0, 0]"#,
+            "operation.runout_um[1]",
+            "-2",
+        ),
+        (
+            r#""runout_um": [5, 0]"#,
+            "operation.runout_um",
+            "one radial offset per tooth",
+        ),
+    ] {
+        let err = parse(&with(fields)).err().unwrap().to_string();
+        assert!(err.contains(field), "{fields}: {err}");
+        assert!(err.contains(expected), "{fields}: {err}");
+    }
+}

@@ -4,22 +4,36 @@
 //! tooth cuts (free flight) is crossed in one exact step, cutting segments get steps in
 //! proportion to their length ([`crate::step::StepPlan`]).
 
-use chatter_dynamics::{ModalModel, Operation};
+use chatter_dynamics::{CuttingEdge, ModalModel, Operation};
 use std::f64::consts::PI;
 
 /// Grid of one principal period tau at `speed_rpm`: the segments (start, end, whether a tooth
-/// cuts).
+/// cuts), cut at the straight teeth's entries and exits ([`edge_segments`] of the cutting edges at
+/// zero depth).
 pub(crate) fn segments(model: &ModalModel, speed_rpm: f64, tau: f64) -> Vec<(f64, f64, bool)> {
+    match model.operation() {
+        Operation::Milling(m) => edge_segments(model, speed_rpm, tau, &m.cutting_edges(0.0)),
+        Operation::Turning(_) => edge_segments(model, speed_rpm, tau, &[]),
+    }
+}
+
+/// Grid of one principal period tau at `speed_rpm` cut at every entry and exit of the cutting
+/// edge elements `edges` (a helical cutter's slices: H(t) is smooth between them); a segment
+/// cuts when some element is in the cut at its middle. No edges: one segment (turning).
+pub(crate) fn edge_segments(
+    model: &ModalModel,
+    speed_rpm: f64,
+    tau: f64,
+    edges: &[CuttingEdge],
+) -> Vec<(f64, f64, bool)> {
     let mut cuts = vec![0.0, tau];
     if let Operation::Milling(m) = model.operation() {
         let omega = 2.0 * PI * speed_rpm / 60.0;
         let (entry, exit) = m.entry_exit_rad();
-        let teeth = m.teeth();
-        for j in 0..teeth {
-            let offset = m.tooth_offset_rad(j);
+        for edge in edges {
             for angle in [entry, exit] {
-                // times in [0, tau) at which tooth j reaches `angle` (mod 2 pi)
-                let t0 = (angle - offset).rem_euclid(2.0 * PI) / omega;
+                // times in [0, tau) at which the element reaches `angle` (mod 2 pi)
+                let t0 = (angle - edge.lead_rad).rem_euclid(2.0 * PI) / omega;
                 let t = t0.rem_euclid(tau);
                 if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
                     cuts.push(t);
@@ -32,8 +46,68 @@ pub(crate) fn segments(model: &ModalModel, speed_rpm: f64, tau: f64) -> Vec<(f64
     cuts.windows(2)
         .map(|w| {
             let mid = 0.5 * (w[0] + w[1]);
-            let h = model.directional_matrix(mid, speed_rpm);
-            (w[0], w[1], h.abs().max() > 0.0)
+            let cutting = match model.operation() {
+                Operation::Turning(_) => model.directional_matrix(mid, speed_rpm).abs().max() > 0.0,
+                Operation::Milling(_) => edges
+                    .iter()
+                    .any(|e| model.edge_directional_matrix(e, mid, speed_rpm).abs().max() > 0.0),
+            };
+            (w[0], w[1], cutting)
+        })
+        .collect()
+}
+
+/// Grid of one principal period tau at `speed_rpm` for a helical cutter's elements `edges`: cut
+/// only where a tooth's engagement begins and ends, the entry of its leading slice and the exit
+/// of its trailing one (the envelope [entry + lag_min, exit + lag_max] of the tooth angle), so
+/// the steps do not crowd at every slice's entry and exit; inside the envelope the slices' entries
+/// and exits fall inside steps, whose coefficients are sampled there ([`crate::step::StepPlan`]),
+/// and a step where no slice cuts has zero coefficients. A segment cuts when its middle lies in
+/// some tooth's envelope.
+pub(crate) fn envelope_segments(
+    model: &ModalModel,
+    speed_rpm: f64,
+    tau: f64,
+    edges: &[CuttingEdge],
+) -> Vec<(f64, f64, bool)> {
+    let Operation::Milling(m) = model.operation() else {
+        return edge_segments(model, speed_rpm, tau, edges);
+    };
+    let omega = 2.0 * PI * speed_rpm / 60.0;
+    let (entry, exit) = m.entry_exit_rad();
+    // per tooth: its lead without lag and the smallest and largest lag of its slices
+    let envelopes: Vec<(f64, f64, f64)> = (0..m.teeth())
+        .filter_map(|j| {
+            let lags = edges
+                .iter()
+                .filter(|e| e.tooth == j)
+                .map(|e| m.tooth_offset_rad(j) - e.lead_rad);
+            let (lo, hi) = lags.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), l| {
+                (lo.min(l), hi.max(l))
+            });
+            lo.is_finite().then_some((m.tooth_offset_rad(j), lo, hi))
+        })
+        .collect();
+    let mut cuts = vec![0.0, tau];
+    for &(offset, lo, hi) in &envelopes {
+        for angle in [entry + lo, exit + hi] {
+            let t = ((angle - offset).rem_euclid(2.0 * PI) / omega).rem_euclid(tau);
+            if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
+                cuts.push(t);
+            }
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
+    cuts.windows(2)
+        .map(|w| {
+            let mid = 0.5 * (w[0] + w[1]);
+            let cutting = envelopes.iter().any(|&(offset, lo, hi)| {
+                let span = exit + hi - (entry + lo);
+                span >= 2.0 * PI
+                    || (omega * mid + offset - (entry + lo)).rem_euclid(2.0 * PI) <= span
+            });
+            (w[0], w[1], cutting)
         })
         .collect()
 }

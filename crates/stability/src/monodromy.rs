@@ -111,7 +111,7 @@ pub const AUTO_STEPS_PER_CYCLE: f64 = 24.0;
 pub(crate) fn principal_period(model: &ModalModel, speed_rpm: f64) -> (f64, usize) {
     let op = model.operation();
     let period = op.principal_period_s(speed_rpm);
-    if op.is_variable_pitch() {
+    if op.has_uneven_teeth() {
         (period, op.delays_per_revolution())
     } else {
         (period, 1)

@@ -12,10 +12,11 @@
 //! bit, as one built from scratch.
 
 use crate::error::{Result, StabilityError, check_condition};
-use crate::grid::segments;
+use crate::grid::{envelope_segments, segments};
 use crate::monodromy::{Discretization, Interp, Monodromy, Scheme, Step, Tap, principal_period};
-use chatter_dynamics::{ModalModel, Operation};
-use nalgebra::DMatrix;
+use chatter_dynamics::simulate::TimeMap;
+use chatter_dynamics::{CuttingEdge, ModalModel, Operation};
+use nalgebra::{DMatrix, Matrix2};
 
 /// Van Loan: exp of [[A, I, 0], [0, 0, I], [0, 0, 0]] h gives e^{A h}, F_1 and F_2.
 fn exp_integrals(a: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
@@ -40,6 +41,32 @@ pub(crate) fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
     m.transpose().as_slice().to_vec()
 }
 
+/// The cutting edge elements of a helical cutter at one depth that share one regenerative delay
+/// (all slices of a tooth when the helix is uniform): one delayed input of the step program.
+#[derive(Debug, Clone)]
+struct EdgeGroup {
+    delay_rad: f64,
+    edges: Vec<CuttingEdge>,
+}
+
+/// The elements of `edges` grouped by their delay (equal delays to 1e-12 relative).
+fn edge_groups(edges: Vec<CuttingEdge>) -> Vec<EdgeGroup> {
+    let mut groups: Vec<EdgeGroup> = Vec::new();
+    for edge in edges {
+        match groups
+            .iter_mut()
+            .find(|g| (g.delay_rad - edge.delay_rad).abs() <= 1e-12 * edge.delay_rad)
+        {
+            Some(g) => g.edges.push(edge),
+            None => groups.push(EdgeGroup {
+                delay_rad: edge.delay_rad,
+                edges: vec![edge],
+            }),
+        }
+    }
+    groups
+}
+
 /// The periodic coefficients per unit depth at one time in modal coordinates: [W | P]
 /// (N x 2N, row-major), W = Phi^T H(t) Phi and P = Phi^T D(t) Phi.
 struct Periodic<'a> {
@@ -48,14 +75,54 @@ struct Periodic<'a> {
     /// Phi (2 x N), row-major.
     phi: Vec<f64>,
     modes: usize,
+    /// A helical cutter's elements at the depth of the plan, by delay (`None`: the teeth).
+    groups: Option<Vec<EdgeGroup>>,
 }
 
 impl Periodic<'_> {
+    /// The delayed inputs: the teeth, or the edge groups of a helical cutter.
+    fn inputs(&self) -> usize {
+        match &self.groups {
+            Some(g) => g.len(),
+            None => self.model.operation().delays_per_revolution(),
+        }
+    }
+
+    /// Input `j`'s delay as the angle (rad) the spindle turns in it: tooth j's pitch, or the
+    /// edge group's delay.
+    fn delay_rad(&self, j: usize) -> f64 {
+        match (&self.groups, self.model.operation()) {
+            (Some(g), _) => g[j].delay_rad,
+            (None, Operation::Milling(m)) => m.tooth_pitch_rad(j),
+            (None, Operation::Turning(_)) => 2.0 * std::f64::consts::PI,
+        }
+    }
+
+    /// Input `j`'s part of H(t) (N/m^2).
+    fn input_matrix(&self, j: usize, t: f64) -> Matrix2<f64> {
+        match &self.groups {
+            Some(g) => g[j]
+                .edges
+                .iter()
+                .map(|e| self.model.edge_directional_matrix(e, t, self.speed_rpm))
+                .sum(),
+            None => self.model.tooth_directional_matrix(j, t, self.speed_rpm),
+        }
+    }
+
     /// Append [W | P] at time `t` to `out`.
     fn push(&self, t: f64, out: &mut Vec<f64>) {
         let n = self.modes;
-        let h = self.model.directional_matrix(t, self.speed_rpm);
-        let d = self.model.process_damping_matrix(t, self.speed_rpm);
+        let (h, d) = match &self.groups {
+            Some(g) => (
+                (0..g.len()).map(|j| self.input_matrix(j, t)).sum(),
+                Matrix2::zeros(),
+            ),
+            None => (
+                self.model.directional_matrix(t, self.speed_rpm),
+                self.model.process_damping_matrix(t, self.speed_rpm),
+            ),
+        };
         let at = out.len();
         out.resize(at + 2 * n * n, 0.0);
         let m = &mut out[at..];
@@ -75,12 +142,10 @@ impl Periodic<'_> {
         }
     }
 
-    /// Append tooth `tooth`'s W_j = Phi^T H_j(t) Phi (N x N, row-major) at time `t` to `out`.
-    fn push_tooth(&self, tooth: usize, t: f64, out: &mut Vec<f64>) {
+    /// Append input `j`'s W_j = Phi^T H_j(t) Phi (N x N, row-major) at time `t` to `out`.
+    fn push_tooth(&self, j: usize, t: f64, out: &mut Vec<f64>) {
         let n = self.modes;
-        let h = self
-            .model
-            .tooth_directional_matrix(tooth, t, self.speed_rpm);
+        let h = self.input_matrix(j, t);
         for p in 0..n {
             for q in 0..n {
                 let mut w = 0.0;
@@ -343,17 +408,94 @@ pub struct StepPlan {
     /// Whether the coefficients are constant (turning): every step of a segment is the same.
     constant: bool,
     period_s: f64,
+    /// A helical cutter: the lag of its slices grows with the depth, so the program is built at
+    /// each depth ([`StepPlan::helical_at_depth`]) from the model, speed and method kept here.
+    helical: Option<Box<(ModalModel, f64, Discretization)>>,
 }
 
 impl StepPlan {
-    /// The plan of `method` for `model` at `speed_rpm`.
+    /// The plan of `method` for `model` at `speed_rpm`. A helical cutter's plan keeps the model
+    /// and builds the program at each depth ([`Self::monodromy`]); with helix zero the cutter is
+    /// the straight one, to the bit.
     pub fn new(model: &ModalModel, speed_rpm: f64, method: Discretization) -> Result<Self> {
         check_condition(speed_rpm, 0.0)?;
         model.require_proportional(method.scheme.name())?;
+        if model.operation().is_helical() {
+            refuse_helical_process_damping(model, method)?;
+            return Ok(Self {
+                modes: model.mode_count(),
+                scheme: method.scheme,
+                a0: DMatrix::zeros(0, 0),
+                segments: Vec::new(),
+                constant: false,
+                period_s: model.operation().principal_period_s(speed_rpm),
+                helical: Some(Box::new((model.clone(), speed_rpm, method))),
+            });
+        }
+        let (tau, _) = principal_period(model, speed_rpm);
+        let periodic = Periodic {
+            model,
+            speed_rpm,
+            phi: row_major(&model.shape_matrix()),
+            modes: model.mode_count(),
+            groups: None,
+        };
+        Self::build(&periodic, method, &segments(model, speed_rpm, tau))
+    }
+
+    /// The program of a helical cutter at `depth_m`: the cutting edge elements at that depth
+    /// ([`chatter_dynamics::Milling::cutting_edges`]), grouped by delay into the delayed inputs,
+    /// the grid cut where each tooth's engagement begins and ends (the crate's `grid` module).
+    fn helical_at_depth(
+        model: &ModalModel,
+        speed_rpm: f64,
+        method: Discretization,
+        depth_m: f64,
+    ) -> Result<Self> {
+        let Operation::Milling(m) = model.operation() else {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: "operation.helix_deg: a helix is for milling only".into(),
+            });
+        };
+        let edges = m.cutting_edges(depth_m);
+        if let Some(e) = edges
+            .iter()
+            .find(|e| e.delay_rad.is_nan() || e.delay_rad <= 0.0)
+        {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason: format!(
+                    "operation.helix_deg: at depth {} mm the teeth's helices cross (tooth {}'s \
+                     delay angle is {} rad); the surface it cuts is not the tooth ahead's",
+                    depth_m * 1e3,
+                    e.tooth,
+                    e.delay_rad
+                ),
+            });
+        }
+        let (tau, _) = principal_period(model, speed_rpm);
+        let segs = envelope_segments(model, speed_rpm, tau, &edges);
+        let periodic = Periodic {
+            model,
+            speed_rpm,
+            phi: row_major(&model.shape_matrix()),
+            modes: model.mode_count(),
+            groups: Some(edge_groups(edges)),
+        };
+        Self::build(&periodic, method, &segs)
+    }
+
+    /// The plan over the grid `segs` of one principal period with the inputs of `periodic`.
+    fn build(
+        periodic: &Periodic,
+        method: Discretization,
+        segs: &[(f64, f64, bool)],
+    ) -> Result<Self> {
+        let (model, speed_rpm) = (periodic.model, periodic.speed_rpm);
         let n = model.mode_count();
         let d = 2 * n;
         let (tau, delays) = principal_period(model, speed_rpm);
-        let segs = segments(model, speed_rpm, tau);
         let cutting_time: f64 = segs.iter().filter(|s| s.2).map(|s| s.1 - s.0).sum();
         let m_cut = method
             .cutting_steps(model, cutting_time / delays as f64)
@@ -367,22 +509,10 @@ impl StepPlan {
             a0[(n + i, i)] = -omegas[i] * omegas[i];
             a0[(n + i, n + i)] = -2.0 * zetas[i] * omegas[i];
         }
-        let periodic = Periodic {
-            model,
-            speed_rpm,
-            phi: row_major(&model.shape_matrix()),
-            modes: n,
-        };
         let constant = matches!(model.operation(), Operation::Turning(_));
-        if model.operation().is_variable_pitch() {
-            let segments = variable_pitch_segments(
-                &periodic,
-                &segs,
-                (m_cut, cutting_time),
-                &a0,
-                method,
-                None,
-            )?;
+        if model.operation().has_uneven_teeth() {
+            let segments =
+                variable_pitch_segments(periodic, segs, (m_cut, cutting_time), &a0, method, None)?;
             return Ok(Self {
                 modes: n,
                 scheme: method.scheme,
@@ -390,6 +520,7 @@ impl StepPlan {
                 segments,
                 constant,
                 period_s: tau,
+                helical: None,
             });
         }
         let segments = segs
@@ -442,6 +573,7 @@ impl StepPlan {
             segments,
             constant,
             period_s: tau,
+            helical: None,
         })
     }
 
@@ -453,6 +585,10 @@ impl StepPlan {
     /// The monodromy operator at depth `depth_m` (m).
     pub fn monodromy(&self, depth_m: f64) -> Result<Monodromy> {
         check_condition(1.0, depth_m)?;
+        if let Some(helical) = &self.helical {
+            let (model, speed_rpm, method) = helical.as_ref();
+            return Self::helical_at_depth(model, *speed_rpm, *method, depth_m)?.monodromy(depth_m);
+        }
         let n = self.modes;
         let d = 2 * n;
         let size = n * d;
@@ -704,33 +840,18 @@ impl StepPlan {
     }
 }
 
-/// Tooth angles under a sinusoidal spindle-speed variation, Omega(t) = Omega_0 (1 + A sin(w_m t))
-/// (Insperger & Stépán 2004; Sastry, Kapoor & DeVor 2002): the angle is Omega_0 s(t) with the
-/// equivalent constant-speed time s(t) = t - (A / w_m) (cos(w_m t) - 1), increasing for A < 1.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct TimeMap {
-    pub(crate) amplitude: f64,
-    pub(crate) omega_m: f64,
-}
-
-impl TimeMap {
-    /// s(t).
-    pub(crate) fn equivalent(&self, t: f64) -> f64 {
-        t - self.amplitude / self.omega_m * ((self.omega_m * t).cos() - 1.0)
+/// Process damping on a helical cutter (D(t) would need the slices' surface normals) is refused,
+/// naming `operation.helix_deg`.
+fn refuse_helical_process_damping(model: &ModalModel, method: Discretization) -> Result<()> {
+    if model.process_damping_n_per_m().is_some_and(|c| c > 0.0) {
+        return Err(StabilityError::Unsupported {
+            method: method.scheme.name(),
+            reason: "operation.helix_deg with process_damping is not modelled (the slices' \
+                     process damping)"
+                .into(),
+        });
     }
-
-    /// The t with s(t) = `s` (Newton from t = s; s' = 1 + A sin(w_m t) >= 1 - A > 0).
-    pub(crate) fn inverse(&self, s: f64) -> f64 {
-        let mut t = s;
-        for _ in 0..100 {
-            let step = (self.equivalent(t) - s) / (1.0 + self.amplitude * (self.omega_m * t).sin());
-            t -= step;
-            if step.abs() <= 1e-15 * (1.0 + t.abs()) {
-                break;
-            }
-        }
-        t
-    }
+    Ok(())
 }
 
 impl StepPlan {
@@ -758,6 +879,15 @@ impl StepPlan {
             });
         }
         let op = model.operation();
+        if op.is_helical() {
+            return Err(StabilityError::Unsupported {
+                method: method.scheme.name(),
+                reason:
+                    "operation.helix_deg with a spindle-speed variation is not modelled in the \
+                         discretizations (the time-domain simulator models both)"
+                        .into(),
+            });
+        }
         let delays = op.delays_per_revolution();
         let q_real = delays as f64 / frequency_ratio;
         let q = q_real.round();
@@ -776,10 +906,7 @@ impl StepPlan {
         let period = q as f64 * tau;
         let revolution = 60.0 / speed_rpm;
         let omega = 2.0 * std::f64::consts::PI / revolution;
-        let map = TimeMap {
-            amplitude: amplitude_ratio,
-            omega_m: 2.0 * std::f64::consts::PI / period,
-        };
+        let map = TimeMap::new(amplitude_ratio, 2.0 * std::f64::consts::PI / period);
         // breakpoints in equivalent time: every entry and exit over the q delays
         let mut cuts = vec![0.0, period];
         if let Operation::Milling(m) = op {
@@ -824,6 +951,7 @@ impl StepPlan {
             speed_rpm,
             phi: row_major(&model.shape_matrix()),
             modes: n,
+            groups: None,
         };
         let segments = variable_pitch_segments(
             &periodic,
@@ -840,6 +968,7 @@ impl StepPlan {
             segments,
             constant: false,
             period_s: period,
+            helical: None,
         })
     }
 }
@@ -863,11 +992,6 @@ fn variable_pitch_segments(
     method: Discretization,
     map: Option<TimeMap>,
 ) -> Result<Vec<Segment>> {
-    let operation = periodic.model.operation();
-    let pitch = |j: usize| match operation {
-        Operation::Milling(m) => m.tooth_pitch_rad(j),
-        Operation::Turning(_) => 2.0 * std::f64::consts::PI,
-    };
     let equivalent = |t: f64| map.map_or(t, |m| m.equivalent(t));
     let omega = 2.0 * std::f64::consts::PI * periodic.speed_rpm / 60.0;
     let period = segs.last().map_or(0.0, |s| s.1);
@@ -966,23 +1090,18 @@ fn variable_pitch_segments(
         for &t in &samples {
             periodic.push(equivalent(t), &mut unit);
         }
-        let mid = equivalent(0.5 * (start + end));
         let mut teeth = Vec::new();
-        for j in 0..operation.delays_per_revolution() {
-            if periodic
-                .model
-                .tooth_directional_matrix(j, mid, periodic.speed_rpm)
-                .abs()
-                .max()
-                == 0.0
-            {
-                continue;
-            }
+        for j in 0..periodic.inputs() {
+            // an input that cuts nowhere the steps sample it has no delayed term here (on a
+            // straight cutter's segment a tooth cuts at every sample or at none)
             let mut tooth_unit = Vec::new();
             for &t in &samples {
                 periodic.push_tooth(j, equivalent(t), &mut tooth_unit);
             }
-            let tau = pitch(j) / omega;
+            if tooth_unit.iter().all(|w| *w == 0.0) {
+                continue;
+            }
+            let tau = periodic.delay_rad(j) / omega;
             let taps = (0..k)
                 .map(|i| {
                     let t0 = start + i as f64 * h;

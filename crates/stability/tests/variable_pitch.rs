@@ -164,22 +164,99 @@ fn fdm_and_sdm_agree_within_one_percent() {
     }
 }
 
+/// The zero-order variable-pitch search (Altintas, Engin & Budak 1999) at even pitch is the
+/// even-pitch lobe table, a different computation (the table's exact lobe solves against the
+/// frequency search of Im(c Lambda) = 0), within 1e-6 at 12 speeds.
 #[test]
-fn zero_order_refuses_a_variable_pitch_by_name() {
-    let model = with_pitch(&examples::schmitz_2023_milling(), Some(&ALTERNATING));
+fn zero_order_variable_pitch_search_at_even_pitch_is_the_lobe_table() {
+    use chatter_stability::zero_order::{OrientedSystem, variable_pitch_lobe, zoa_lobes};
+    let model = examples::schmitz_2023_milling();
+    let system = OrientedSystem::from_model(&model).unwrap();
+    let even = [std::f64::consts::FRAC_PI_2; 4];
+    let speeds: Vec<f64> = (0..12).map(|i| 4000.0 + 1000.0 * i as f64).collect();
+    let table = zoa_lobes(&model, &speeds).unwrap();
+    for (rpm, expected) in speeds.iter().zip(&table) {
+        let lobe = variable_pitch_lobe(&system, &even, *rpm).unwrap();
+        assert!(
+            (lobe.depth_m / expected.depth_m - 1.0).abs() < 1e-6,
+            "{rpm}: search {} table {}",
+            lobe.depth_m,
+            expected.depth_m
+        );
+        assert!((lobe.chatter_hz / expected.chatter_hz - 1.0).abs() < 1e-6);
+    }
+}
+
+/// The zero-order method with variable pitch against SDM (which keeps the time-periodic
+/// forces) on seed 001's mill at 20 % immersion at 24 speeds: the median difference below 8 %,
+/// four in five below 15 %, all below 50 % (measured: 5.3 %, 12 %, 37 %; the zero-order
+/// method's error: the variable-pitch
+/// lobes have narrow peaks, e.g. SDM 4.75 mm against ZOA 2.98 mm at 11 500 rpm, which the
+/// averaged forces miss; the even-pitch ZOA misses the lobe peaks by 10 % at this immersion);
+/// the alternating cutter's stability gain near its design speed
+/// (Altintas, Engin & Budak 1999), w_c (tau_2 - tau_1) = pi with tau_2 - tau_1 = 40 deg / Omega,
+/// is seen by both: the lowest limit of the variable-pitch cutter over 9 600-11 200 rpm is at
+/// least twice the even cutter's lowest limit over all speeds.
+#[test]
+fn zero_order_variable_pitch_agrees_with_sdm() {
+    let even = examples::schmitz_2023_milling();
+    let model = with_pitch(&even, Some(&ALTERNATING));
     let options = BoundaryOptions::default();
-    let err = Method::Zoa.prepare(&model, &options).err().unwrap();
-    let text = err.to_string();
-    assert!(text.contains("operation.pitch_deg"), "{text}");
-    assert!(text.contains("70"), "{text}");
-    // the discretizations still search the boundary (from zero depth, without the guide)
-    assert!(
-        Method::Fdm
-            .prepare(&model, &options)
-            .unwrap()
-            .limiting_depth(9000.0)
-            .unwrap()
-            .depth_m
-            > 0.0
-    );
+    let zoa = Method::Zoa.prepare(&model, &options).unwrap();
+    let sdm = Method::Sdm.prepare(&model, &options).unwrap();
+    let zoa_even = Method::Zoa.prepare(&even, &options).unwrap();
+    let mut errors: Vec<f64> = (0..24)
+        .map(|i| {
+            let rpm = 4000.0 + 500.0 * i as f64;
+            let (z, s) = (
+                zoa.limiting_depth(rpm).unwrap().depth_m,
+                sdm.limiting_depth(rpm).unwrap().depth_m,
+            );
+            eprintln!("{rpm}: zoa {:.4} mm sdm {:.4} mm", z * 1e3, s * 1e3);
+            (z / s - 1.0).abs()
+        })
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    eprintln!("ZOA-SDM relative differences, sorted: {errors:.3?}");
+    assert!(errors[12] < 0.08, "median {}", errors[12]);
+    assert!(errors[19] < 0.15, "80th percentile {}", errors[19]);
+    assert!(errors[23] < 0.5, "largest {}", errors[23]);
+    let lowest = |solver: &dyn chatter_stability::prepared::PreparedSolver, speeds: &[f64]| {
+        speeds
+            .iter()
+            .map(|&rpm| solver.limiting_depth(rpm).unwrap().depth_m)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let all: Vec<f64> = (0..=120).map(|i| 4000.0 + 100.0 * i as f64).collect();
+    let design: Vec<f64> = (0..=16).map(|i| 9600.0 + 100.0 * i as f64).collect();
+    let even_lowest = lowest(zoa_even.as_ref(), &all);
+    for (name, solver) in [("zoa", &zoa), ("sdm", &sdm)] {
+        let near_design = lowest(solver.as_ref(), &design);
+        eprintln!(
+            "{name}: even lowest {:.4} mm, variable lowest near the design speed {:.4} mm",
+            even_lowest * 1e3,
+            near_design * 1e3
+        );
+        assert!(near_design > 2.0 * even_lowest, "{name}");
+    }
+}
+
+/// A variable helix (delays along the axis) is refused by the zero-order method by name.
+#[test]
+fn zero_order_refuses_a_variable_helix_by_name() {
+    let base = examples::schmitz_2023_milling();
+    let Operation::Milling(m) = base.operation() else {
+        panic!("a milling model")
+    };
+    let milling = chatter_dynamics::Milling::new(4, 0.2, m.direction(), Some(12e-3), None)
+        .unwrap()
+        .with_helix_deg(Some(&[30.0, 35.0, 30.0, 35.0]))
+        .unwrap();
+    let model = base.with_operation(Operation::Milling(milling)).unwrap();
+    let err = Method::Zoa
+        .prepare(&model, &BoundaryOptions::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("operation.helix_deg"), "{err}");
 }

@@ -19,6 +19,10 @@
 //! iteration of [`crate::process_damping::process_damping_limiting_depth`] without iterating
 //! (module `damped`).
 //!
+//! A variable-pitch cutter (Altintas, Engin & Budak 1999) replaces N (1 - e^{-i w tau}) by the
+//! pitch-averaged regeneration sum_j (1 - e^{-i w tau_j}) and is searched in frequency at each
+//! speed ([`variable_pitch_lobe`]).
+//!
 //! [`limiting_depths`] and [`zoa_lobes`] are the model-level entries; the tables serve callers
 //! that hold the modes and the directional matrix themselves (the samplers of `chatter-gap`).
 //!
@@ -36,11 +40,13 @@ mod damped;
 mod measured;
 mod system;
 mod table;
+mod variable_pitch;
 
 pub use damped::ProcessDampedTable;
 pub use measured::{MeasuredLobeTable, PreparedMeasured, measured_limiting_depths};
 pub use system::{ModalTerm, OrientedSystem};
 pub use table::LobeTable;
+pub use variable_pitch::variable_pitch_lobe;
 
 use crate::boundary::LobePoint;
 use crate::error::{Result, StabilityError, check_condition, invalid};
@@ -112,12 +118,22 @@ pub struct PreparedZeroOrder {
 enum Tables {
     Bare(LobeTable),
     Damped(ProcessDampedTable<'static>),
+    /// A variable-pitch cutter: the system and the pitches (rad), searched at each speed
+    /// ([`variable_pitch_lobe`]).
+    VariablePitch(OrientedSystem, Vec<f64>),
 }
 
 impl PreparedZeroOrder {
     /// Tabulate `model` (with its process damping, 003, when it has one).
     pub fn new(model: &ModalModel, options: &ZeroOrderOptions) -> Result<Self> {
         options.validate()?;
+        if let Some(pitches_rad) = system::variable_pitch_of(model)? {
+            return Ok(Self {
+                model: model.clone(),
+                tables: Tables::VariablePitch(OrientedSystem::averaged(model)?, pitches_rad),
+                options: *options,
+            });
+        }
         let table = LobeTable::new(OrientedSystem::from_model(model)?);
         // the slopes at unit C / V, scaled by C / V at each speed
         let per_cv = damping_ratio_slopes_per_cv(model);
@@ -169,6 +185,11 @@ impl PreparedSolver for PreparedZeroOrder {
                 d.lobes(tau, self.model.process_damping_per_width(speed_rpm), 1)?
             }
             Tables::Bare(t) => t.lobes(tau, 1)?,
+            Tables::VariablePitch(system, pitches_rad) => {
+                variable_pitch_lobe(system, pitches_rad, speed_rpm)
+                    .into_iter()
+                    .collect()
+            }
         };
         Ok(LobePoint::below_ceiling(
             speed_rpm,

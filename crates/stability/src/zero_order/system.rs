@@ -174,9 +174,29 @@ impl OrientedSystem {
         })
     }
 
-    /// The system of `model`: its modes and [`ModalModel::average_directional_matrix`].
+    /// The system of `model`: its modes and [`ModalModel::average_directional_matrix`]. A
+    /// helical cutter's average is the straight one's (the helix only shifts the slices'
+    /// phases). A variable-pitch or variable-helix cutter is refused by field name: its lobes
+    /// are not one delay's ([`super::PreparedZeroOrder`] searches a variable pitch).
     pub fn from_model(model: &ModalModel) -> Result<Self> {
-        refuse_variable_pitch(model)?;
+        if let Some(pitches_rad) = variable_pitch_of(model)? {
+            return Err(crate::StabilityError::Unsupported {
+                method: "zoa",
+                reason: format!(
+                    "operation.pitch_deg = {:?}: one delay per tooth; the lobe table is for even \
+                     pitch (the prepared zero-order solver searches a variable pitch)",
+                    pitches_rad
+                        .iter()
+                        .map(|p| p.to_degrees())
+                        .collect::<Vec<_>>()
+                ),
+            });
+        }
+        Self::averaged(model)
+    }
+
+    /// The modes and the averaged directional matrix of `model`, whatever its pitch.
+    pub(crate) fn averaged(model: &ModalModel) -> Result<Self> {
         let a = model.average_directional_matrix();
         let modes = model
             .modes()
@@ -347,24 +367,39 @@ pub(crate) fn principal_sqrt(z: Complex64) -> Complex64 {
     }
 }
 
-/// The zero-order method here is the even-pitch one (one delay, Altintas and Budak 1995); a
-/// variable-pitch cutter (several delays; Altintas, Engin and Budak 1999) is refused by the
-/// field's name and values. FDM and SDM handle it.
-pub(crate) fn refuse_variable_pitch(model: &ModalModel) -> Result<()> {
-    match model.operation() {
-        chatter_dynamics::Operation::Milling(m) if m.is_variable_pitch() => {
-            Err(crate::StabilityError::Unsupported {
-                method: "zoa",
-                reason: format!(
-                    "operation.pitch_deg = {:?} is a variable-pitch cutter (one delay per tooth); \
-                     the zero-order method here assumes even pitch (the variable-pitch form of \
-                     Altintas, Engin and Budak 1999 is not implemented): use fdm or sdm",
-                    m.pitch_deg().unwrap_or_default()
-                ),
-            })
-        }
-        _ => Ok(()),
+/// The pitches (rad) of a variable-pitch cutter, for the zero-order method's variable-pitch
+/// search (Altintas, Engin and Budak 1999, [`super::variable_pitch_lobe`]); `None` for even
+/// pitch. Refused by field name: a variable helix (its delays vary along the axis, which the
+/// averaged equation does not hold) and process damping with a variable pitch.
+pub(crate) fn variable_pitch_of(model: &ModalModel) -> Result<Option<Vec<f64>>> {
+    let chatter_dynamics::Operation::Milling(m) = model.operation() else {
+        return Ok(None);
+    };
+    if m.is_variable_helix() {
+        return Err(crate::StabilityError::Unsupported {
+            method: "zoa",
+            reason: format!(
+                "operation.helix_deg = {:?} is a variable-helix cutter (the delay varies along \
+                 the axis); the zero-order method averages over one delay per tooth: use fdm or \
+                 sdm",
+                m.helix_per_tooth_deg().unwrap_or_default()
+            ),
+        });
     }
+    if !m.is_variable_pitch() {
+        return Ok(None);
+    }
+    if model.process_damping_n_per_m().is_some_and(|c| c > 0.0) {
+        return Err(crate::StabilityError::Unsupported {
+            method: "zoa",
+            reason: format!(
+                "operation.pitch_deg = {:?} with process_damping: the zero-order variable-pitch \
+                 search has no process damping; use fdm or sdm",
+                m.pitch_deg().unwrap_or_default()
+            ),
+        });
+    }
+    Ok(Some((0..m.teeth()).map(|j| m.tooth_pitch_rad(j)).collect()))
 }
 
 #[cfg(test)]
