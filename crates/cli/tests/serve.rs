@@ -81,7 +81,10 @@ fn kill_9_during_learning_loses_nothing_and_fails_the_job() {
     // the job is under way: its progress reports a stage
     wait_for("the job's progress", Duration::from_secs(60), || {
         let s = get(addr, &format!("/api/jobs/{job}")).json();
-        s["job"]["status"] == "running" && s["progress"]["stage"].as_str().is_some_and(|t| !t.is_empty())
+        s["job"]["status"] == "running"
+            && s["progress"]["stage"]
+                .as_str()
+                .is_some_and(|t| !t.is_empty())
     });
     std::thread::sleep(Duration::from_millis(500));
     child.kill().unwrap(); // SIGKILL
@@ -90,10 +93,19 @@ fn kill_9_during_learning_loses_nothing_and_fails_the_job() {
     let (mut child, addr) = serve(dir.path(), true);
     let j = get(addr, &format!("/api/jobs/{job}")).json();
     assert_eq!(j["job"]["status"], "failed", "{j}");
-    assert!(j["job"]["error"].as_str().unwrap().contains("server stopped"), "{j}");
+    assert!(
+        j["job"]["error"]
+            .as_str()
+            .unwrap()
+            .contains("server stopped"),
+        "{j}"
+    );
     assert!(j["job"]["result"].is_null());
     assert_eq!(
-        get(addr, "/api/setups").json()["setups"].as_array().unwrap().len(),
+        get(addr, "/api/setups").json()["setups"]
+            .as_array()
+            .unwrap()
+            .len(),
         2,
         "the example is not seeded twice, the own setup is kept"
     );

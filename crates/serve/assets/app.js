@@ -114,8 +114,9 @@ function chart(container, spec) {
       }
     }
     if (s.label) {
-      svg.append(el("line", { x1: W - R - 230, x2: W - R - 205, y1: legendY - 4, y2: legendY - 4, stroke: s.color, "stroke-width": 3, "stroke-dasharray": s.dash || null }));
-      svg.append(el("text", { x: W - R - 200, y: legendY, "font-size": 12 }, s.label));
+      const lx = spec.legendLeft ? L + 10 : W - R - 230;
+      svg.append(el("line", { x1: lx, x2: lx + 25, y1: legendY - 4, y2: legendY - 4, stroke: s.color, "stroke-width": 3, "stroke-dasharray": s.dash || null }));
+      svg.append(el("text", { x: lx + 30, y: legendY, "font-size": 12 }, s.label));
       legendY += 16;
     }
   }
@@ -247,6 +248,8 @@ async function showLobes() {
   const q = new URLSearchParams({ max_depth_mm: f.get("max_depth_mm"), risk: f.get("risk") });
   const r = await api(`/api/setups/${state.setup}/lobes?${q}`);
   drawLobes(r);
+  // on screen: after the next frame is laid out and painted
+  await new Promise(done => requestAnimationFrame(() => setTimeout(done, 0)));
   const ms = performance.now() - started;
   const t = document.getElementById("lobes-time");
   t.textContent = `on screen in ${ms.toFixed(0)} ms (server ${r.server_ms.toFixed(0)} ms)`;
@@ -268,7 +271,7 @@ function drawLobes(r) {
   ];
   if (rec) series.push({ points: [[rec.speed_rpm, rec.depth_mm, "recommended cut"]], color: "#f90", kind: "star", label: "recommended cut", cls: "recommended" });
   chart(document.getElementById("lobes-chart"), {
-    xlabel: "spindle speed (rpm)", ylabel: "axial depth (mm)", ymax: top, series,
+    xlabel: "spindle speed (rpm)", ylabel: "axial depth (mm)", ymax: top, series, legendLeft: true,
     hover: (x, y) => {
       const p = nearest(lobes, x);
       const limit = p[1] === null ? "no limit below the ceiling" : `${fmt(p[1], 2)} mm`;
@@ -306,7 +309,7 @@ function renderCuts(d) {
   const t = document.getElementById("cut-table");
   t.replaceChildren(
     el("tr", {}, ["#", "speed (rpm)", "depth (mm)", "result", "chatter (Hz)", "from", "recording", ""].map(h => el("th", {}, h))),
-    d.cuts.map((c, k) => {
+    ...d.cuts.map((c, k) => {
       const flip = el("button", { type: "button", class: "overrule" }, c.stable ? "mark chatter" : "mark stable");
       flip.onclick = () => run(async () => {
         await postJson(`/api/cuts/${c.id}/result`, { stable: !c.stable });
@@ -344,7 +347,7 @@ function renderDetection(r) {
 function renderJobs(d) {
   const t = document.getElementById("job-table");
   t.replaceChildren(el("tr", {}, ["run", "status", "started (UTC)", "finished (UTC)", "note"].map(h => el("th", {}, h))),
-    d.jobs.map(j => el("tr", {}, el("td", {}, j.id), el("td", { class: "text job-status" }, j.status), el("td", {}, j.created_at),
+    ...d.jobs.map(j => el("tr", {}, el("td", {}, j.id), el("td", { class: "text job-status" }, j.status), el("td", {}, j.created_at),
       el("td", {}, j.finished_at || ""), el("td", { class: "text" }, j.error || (j.result ? j.result.diagnosis.verdict : "")))));
   const done = d.jobs.find(j => j.status === "done");
   if (done && !state.job) renderLearn(done);
@@ -385,7 +388,7 @@ async function follow(id) {
     if (j.status === "running") {
       const p = r.progress;
       if (p && p.total > 0) { bar.max = p.total; bar.value = p.done; } else { bar.removeAttribute("value"); }
-      stage.textContent = p ? `${p.stage}${p.total ? ` (${p.done}/${p.total})` : ""}${p.cancel_requested ? " — cancelling" : ""}` : "running";
+      stage.textContent = p ? `${p.stage}${p.detail ? ", " + p.detail : ""}${p.total ? ` (${p.done}/${p.total})` : ""}${p.cancel_requested ? " — cancelling" : ""}` : "running";
       state.poll = setTimeout(tick, 500);
       return;
     }

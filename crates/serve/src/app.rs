@@ -22,13 +22,13 @@ use crate::db::{Db, NewCut, StoredFile};
 use crate::error::{Result, ServeError};
 use crate::store::{DataDir, Upload, UploadKind, check};
 use crate::work::{self, FitRequest, LearnRequest, LobeRequest, RecordingRequest, TapDirections};
+use axum::Json;
 use axum::Router;
 use axum::extract::{DefaultBodyLimit, Multipart, Path, Query, Request, State};
 use axum::http::{HeaderMap, Method, header};
 use axum::middleware::{self, Next};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::{get, post};
-use axum::Json;
 use chatter_dynamics::{ModalModel, ModelFile, Observations};
 use serde::Deserialize;
 use serde_json::{Value, json};
@@ -61,6 +61,7 @@ pub struct App {
 #[derive(Debug, Default)]
 pub struct JobProgress {
     stage: Mutex<String>,
+    detail: Mutex<String>,
     done: AtomicUsize,
     total: AtomicUsize,
     cancel: AtomicBool,
@@ -72,6 +73,22 @@ impl chatter_progress::Observer for JobProgress {
         self.total.store(total, Ordering::Relaxed);
     }
 
+    fn stage(&self, index: usize, beta: f64, _acceptance: f64) {
+        *self
+            .detail
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) =
+            format!("tempering stage {index}, exponent {beta:.3}");
+    }
+
+    fn class_started(&self, index: usize, total: usize, _parameter: f64) {
+        *self
+            .detail
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) =
+            format!("model class {} of {total}", index + 1);
+    }
+
     fn cancelled(&self) -> bool {
         self.cancel.load(Ordering::Relaxed)
     }
@@ -79,7 +96,14 @@ impl chatter_progress::Observer for JobProgress {
 
 impl work::Stages for JobProgress {
     fn step(&self, name: &str) {
-        *self.stage.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = name.into();
+        *self
+            .stage
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = name.into();
+        self.detail
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clear();
         self.done.store(0, Ordering::Relaxed);
         self.total.store(0, Ordering::Relaxed);
     }
@@ -122,8 +146,9 @@ impl App {
                  & tool screen",
             )
         })?;
-        let model = ModalModel::from_json_str(&row.model.to_string(), std::path::Path::new("model"))
-            .map_err(|e| ServeError::Job(format!("the stored model: {e}")))?;
+        let model =
+            ModalModel::from_json_str(&row.model.to_string(), std::path::Path::new("model"))
+                .map_err(|e| ServeError::Job(format!("the stored model: {e}")))?;
         Ok((row.id, model))
     }
 
@@ -154,8 +179,14 @@ impl App {
 pub fn router(app: Arc<App>) -> Router {
     Router::new()
         .route("/", get(|| async { Html(INDEX_HTML) }))
-        .route("/assets/app.js", get(|| async { asset(APP_JS, "text/javascript") }))
-        .route("/assets/app.css", get(|| async { asset(APP_CSS, "text/css") }))
+        .route(
+            "/assets/app.js",
+            get(|| async { asset(APP_JS, "text/javascript") }),
+        )
+        .route(
+            "/assets/app.css",
+            get(|| async { asset(APP_CSS, "text/css") }),
+        )
         .route("/api/setups", get(list_setups).post(add_setup))
         .route("/api/setups/{id}", get(setup_detail))
         .route("/api/setups/{id}/frf", post(upload_frf))
@@ -170,7 +201,9 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/api/cuts/{id}/result", post(set_cut_result))
         .route("/api/jobs/{id}", get(job_status))
         .route("/api/jobs/{id}/cancel", post(cancel_job))
-        .layer(DefaultBodyLimit::max(crate::store::MAX_UPLOAD_BYTES + 256 * 1024))
+        .layer(DefaultBodyLimit::max(
+            crate::store::MAX_UPLOAD_BYTES + 256 * 1024,
+        ))
         .layer(middleware::from_fn_with_state(app.clone(), guard))
         .with_state(app)
 }
@@ -233,7 +266,7 @@ struct Form {
 
 impl Form {
     async fn read(mut multipart: Multipart) -> Result<Self> {
-        let too_large = |e: axum::extract::multipart::MultipartError| {
+        let form_error = |e: axum::extract::multipart::MultipartError| {
             if e.status() == axum::http::StatusCode::PAYLOAD_TOO_LARGE {
                 ServeError::bad(
                     "file",
@@ -250,17 +283,17 @@ impl Form {
             fields: HashMap::new(),
             file: None,
         };
-        while let Some(field) = multipart.next_field().await.map_err(too_large)? {
+        while let Some(field) = multipart.next_field().await.map_err(form_error)? {
             let name = field.name().unwrap_or_default().to_string();
             if name == "file" {
                 let shown = field.file_name().unwrap_or_default().to_string();
-                let bytes = field.bytes().await.map_err(too_large)?;
+                let bytes = field.bytes().await.map_err(form_error)?;
                 form.file = Some(Upload {
                     name: shown,
                     bytes: bytes.to_vec(),
                 });
             } else {
-                let value = field.text().await.map_err(too_large)?;
+                let value = field.text().await.map_err(form_error)?;
                 form.fields.insert(name, value.trim().to_string());
             }
         }
@@ -414,7 +447,12 @@ async fn upload_frf(
     let mut form = Form::read(multipart).await?;
     let modes = match form.number("modes")? {
         Some(n) if n.fract() == 0.0 && n >= 1.0 => Some(n as usize),
-        Some(n) => return Err(ServeError::bad("modes", format!("{n}: expected a count >= 1"))),
+        Some(n) => {
+            return Err(ServeError::bad(
+                "modes",
+                format!("{n}: expected a count >= 1"),
+            ));
+        }
         None => None,
     };
     let request = FitRequest {
@@ -468,10 +506,16 @@ async fn upload_model(
             work::check_model(&text, shown)
         },
         move |db, file, (_, model)| {
-            let text = serde_json::to_string_pretty(model)
-                .map_err(|e| ServeError::Job(e.to_string()))?;
-            db.add_model(id, &text, &format!("uploaded {}", file.original_name), None, Some(file))
-                .map(drop)
+            let text =
+                serde_json::to_string_pretty(model).map_err(|e| ServeError::Job(e.to_string()))?;
+            db.add_model(
+                id,
+                &text,
+                &format!("uploaded {}", file.original_name),
+                None,
+                Some(file),
+            )
+            .map(drop)
         },
     )
     .await?;
@@ -501,7 +545,10 @@ async fn lobes(
         request.risk.to_bits(),
     );
     let cell = {
-        let mut cache = app.lobes.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut cache = app
+            .lobes
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
         if cache.len() >= LOBE_CACHE {
             let mut keys: Vec<LobeKey> = cache.keys().copied().collect();
             keys.sort_unstable();
@@ -514,7 +561,9 @@ async fn lobes(
     // concurrent requests for the same diagram wait for one computation
     let started = std::time::Instant::now();
     let diagram = cell
-        .get_or_try_init(|| blocking(move || work::lobes(&model, &request, &chatter_progress::Silent)))
+        .get_or_try_init(|| {
+            blocking(move || work::lobes(&model, &request, &chatter_progress::Silent))
+        })
         .await?
         .clone();
     let cuts = app.db.cuts(id)?;
@@ -691,8 +740,7 @@ async fn start_learn(
             "no cuts logged yet: enter cuts or upload recordings on the Cut log screen first",
         ));
     }
-    let request_json =
-        serde_json::to_value(request).map_err(|e| ServeError::Job(e.to_string()))?;
+    let request_json = serde_json::to_value(request).map_err(|e| ServeError::Job(e.to_string()))?;
     let job = app.db.start_job(id, "learn", &request_json)?;
     let progress = Arc::new(JobProgress::default());
     app.jobs
@@ -713,7 +761,9 @@ async fn start_learn(
                     None,
                     Some("cancelled by the user; nothing was kept"),
                 ),
-                (Err(e), false) => worker.db.finish_job(job, "failed", None, Some(&e.to_string())),
+                (Err(e), false) => worker
+                    .db
+                    .finish_job(job, "failed", None, Some(&e.to_string())),
             };
             // a job whose row cannot be written stays `running` and is marked failed at the
             // next start, as after a crash
@@ -738,7 +788,8 @@ async fn job_status(State(app): State<Arc<App>>, Path(id): Path<i64>) -> Result<
         .cloned();
     let progress = live.map(|p| {
         json!({
-            "stage": *p.stage.lock().unwrap_or_else(std::sync::PoisonError::into_inner),
+            "stage": p.stage.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone(),
+            "detail": p.detail.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone(),
             "done": p.done.load(Ordering::Relaxed),
             "total": p.total.load(Ordering::Relaxed),
             "cancel_requested": p.cancel.load(Ordering::Relaxed),
@@ -792,7 +843,12 @@ async fn adopt_model(
         .as_ref()
         .and_then(|r| r.get(a.which.as_str()))
         .and_then(|r| r.get("model"))
-        .ok_or_else(|| ServeError::bad("which", format!("`{}`: expected update or diagnosis", a.which)))?;
+        .ok_or_else(|| {
+            ServeError::bad(
+                "which",
+                format!("`{}`: expected update or diagnosis", a.which),
+            )
+        })?;
     let text = serde_json::to_string_pretty(model).map_err(|e| ServeError::Job(e.to_string()))?;
     work::check_model(&text, "the learned model")?;
     let model_id = app.db.add_model(
@@ -811,9 +867,10 @@ async fn export(
 ) -> Result<Response> {
     let body = match name.as_str() {
         "model.json" => {
-            let row = app.db.current_model(id)?.ok_or_else(|| {
-                ServeError::NotFound(format!("a model of setup {id}"))
-            })?;
+            let row = app
+                .db
+                .current_model(id)?
+                .ok_or_else(|| ServeError::NotFound(format!("a model of setup {id}")))?;
             serde_json::to_string_pretty(&row.model)
         }
         "observations.json" => Ok(app.observations(id)?.to_json_string()),
@@ -823,7 +880,9 @@ async fn export(
                 .jobs(id)?
                 .into_iter()
                 .find(|j| j.status == "done")
-                .ok_or_else(|| ServeError::NotFound(format!("a finished learning run of setup {id}")))?;
+                .ok_or_else(|| {
+                    ServeError::NotFound(format!("a finished learning run of setup {id}"))
+                })?;
             serde_json::to_string_pretty(&job.result)
         }
         other => return Err(ServeError::NotFound(format!("export {other}"))),

@@ -80,8 +80,7 @@ CREATE TABLE jobs (
 "];
 
 /// What a job that was running when the server stopped is marked with.
-pub const INTERRUPTED: &str =
-    "the server stopped while this job ran (killed or crashed); nothing of it was kept: run it again";
+pub const INTERRUPTED: &str = "the server stopped while this job ran (killed or crashed); nothing of it was kept: run it again";
 
 /// The database behind one lock: requests are short, and the lock makes every read see whole
 /// transactions.
@@ -510,11 +509,7 @@ impl Db {
     /// One job.
     pub fn job(&self, id: i64) -> Result<JobRow> {
         self.lock()
-            .query_row(
-                &format!("{JOB_COLUMNS} WHERE id = ?1"),
-                params![id],
-                job_of,
-            )
+            .query_row(&format!("{JOB_COLUMNS} WHERE id = ?1"), params![id], job_of)
             .optional()?
             .ok_or_else(|| ServeError::NotFound(format!("job {id}")))
     }

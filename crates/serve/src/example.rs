@@ -50,7 +50,12 @@ pub fn seed(app: &App) -> Result<i64> {
     let campaign = chatter_gap::synthesize(&nominal, &scenario).map_err(job)?;
     let frequencies: Vec<f64> = (200..=1500).map(f64::from).collect();
     let tap = Frf::from_model(&nominal, 0, 0, frequencies).map_err(job)?;
-    let uff = to_uff58_string(&[Uff58Record::receptance(&tap, "seed 001 mill x tap test", (1, 1), (1, 1))]);
+    let uff = to_uff58_string(&[Uff58Record::receptance(
+        &tap,
+        "seed 001 mill x tap test",
+        (1, 1),
+        (1, 1),
+    )]);
     let staged = app.data().stage(UploadKind::Frf, "uff", uff.as_bytes())?;
     let shown = "seed001_tap_x.uff";
     let (fitted, report) = fit_tap_test(
@@ -84,7 +89,13 @@ pub fn seed(app: &App) -> Result<i64> {
     let kept = staged.keep()?;
     let written = app
         .db()
-        .add_model(id, &fitted, &format!("fitted to the tap test {shown}"), Some(&report), Some(&stored))
+        .add_model(
+            id,
+            &fitted,
+            &format!("fitted to the tap test {shown}"),
+            Some(&report),
+            Some(&stored),
+        )
         .and_then(|_| {
             let cuts: Vec<NewCut> = campaign
                 .cuts

@@ -79,7 +79,9 @@ pub fn check(upload: &Upload, kind: UploadKind) -> Result<&'static str> {
             name.chars().count()
         ));
     }
-    if name.contains(['/', '\\', ':']) || name.starts_with('.') || name.chars().any(char::is_control)
+    if name.contains(['/', '\\', ':'])
+        || name.starts_with('.')
+        || name.chars().any(char::is_control)
     {
         return bad(format!(
             "name `{}`: expected a plain file name (no folders, drive letters or leading dot); \

@@ -1,7 +1,7 @@
 //! What each screen computes, over the library crates the CLI calls: the modal fit of a tap test
 //! (`chatter fit-frf`: [`chatter_frf::fit_modes`]), the lobes with their Type B bands and the
 //! recommended cut (`chatter bands --kind geometric`, `chatter recommend`:
-//! [`chatter_jobs::bands::geometric`], [`chatter_stability::recommend::highest_mrr_cut`]),
+//! [`type_b_offsets`], [`chatter_stability::recommend::highest_mrr_cut`]),
 //! chatter detection of a recording (`chatter detect`: [`chatter_jobs::detect::detect_record`])
 //! and learning (`chatter update`, `chatter diagnose`: [`chatter_jobs::update`],
 //! [`chatter_jobs::diagnose`]). Results are JSON for the page, curves thinned to what a
@@ -12,11 +12,12 @@ use chatter_dynamics::model_file::ModeFile;
 use chatter_dynamics::{ModalModel, ModelFile, Observations, Operation, SignalRecord, limits};
 use chatter_frf::{FitOptions, fit_modes, read_frf};
 use chatter_progress::{Observer, Silent};
-use chatter_stability::Method;
 use chatter_stability::boundary::BoundaryOptions;
+use chatter_stability::boundary::LobePoint;
 use chatter_stability::recommend::{RecommendOptions, highest_mrr_cut};
 use chatter_stability::speed_grid::lobe_speeds_rpm;
-use chatter_uncertainty::geometric::TypeBOffsets;
+use chatter_stability::{DominantMultiplier, Method, PreparedSolver};
+use chatter_uncertainty::geometric::{TypeBOffsets, type_b_offsets};
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -135,8 +136,12 @@ pub fn fit_tap_test(
         modes: request.modes,
         ..FitOptions::default()
     };
-    let fit = fit_modes(&frf, fmin, fmax, &options)
-        .map_err(|e| ServeError::bad("file", format!("fitting `{shown}`: {}", named(e, path, shown))))?;
+    let fit = fit_modes(&frf, fmin, fmax, &options).map_err(|e| {
+        ServeError::bad(
+            "file",
+            format!("fitting `{shown}`: {}", named(e, path, shown)),
+        )
+    })?;
     let mut file = process.clone();
     let tapped = request.directions.names();
     file.modes = current.map_or_else(Vec::new, |c| {
@@ -218,7 +223,9 @@ pub fn check_model(text: &str, shown: &str) -> Result<(ModalModel, ModelFile)> {
     if file.modes.is_empty() {
         return Err(ServeError::bad(
             "file",
-            format!("`{shown}`: a model with modes is expected; upload a measured FRF as a tap test"),
+            format!(
+                "`{shown}`: a model with modes is expected; upload a measured FRF as a tap test"
+            ),
         ));
     }
     Ok((model, file))
@@ -234,26 +241,33 @@ pub struct LobeRequest {
 }
 
 /// The lobe diagram of `model` on the default speeds ([`lobe_speeds_rpm`]: lobe numbers 1-12
-/// of the dominant mode, 20 per lobe): FDM limiting depths and chatter frequencies, 001's Type B
-/// offset boundaries (100 rpm, 0.2 mm, the paper's example) and the highest-MRR cut at the
-/// request's risk (milling only).
+/// of the dominant mode, 20 per lobe): FDM limiting depths and chatter frequencies (as
+/// [`chatter_jobs::bands::lobes`]), 001's Type B offset boundaries (100 rpm, 0.2 mm, the
+/// paper's example; [`type_b_offsets`]) and the highest-MRR cut at the request's risk (milling
+/// only) read from the same diagram.
 pub fn lobes(model: &ModalModel, request: &LobeRequest, observer: &dyn Observer) -> Result<Value> {
     limits::DEPTH_MM
         .check("max_depth_mm", request.max_depth_mm)
         .map_err(|e| ServeError::bad("max_depth_mm", e.to_string()))?;
     let speeds = lobe_speeds_rpm(model);
-    let offsets = TypeBOffsets::new(100.0, 0.2).map_err(job_error)?;
-    let banded = chatter_jobs::bands::geometric(model, Method::Fdm, &speeds, offsets, observer)
+    let fdm = Method::Fdm
+        .prepare(model, &BoundaryOptions::default())
         .map_err(job_error)?;
+    let lobes = fdm.lobes(&speeds, observer).map_err(job_error)?;
+    let offsets = TypeBOffsets::new(100.0, 0.2).map_err(job_error)?;
+    let bands =
+        type_b_offsets(&chatter_jobs::bands::finite_curve(&lobes), offsets).map_err(job_error)?;
     let recommendation = match model.operation() {
         Operation::Milling(_) => {
             let mut options = RecommendOptions::new(request.max_depth_mm * 1e-3);
             options.risk = request.risk;
-            let fdm = Method::Fdm
-                .prepare(model, &BoundaryOptions::default())
-                .map_err(job_error)?;
+            let computed = Computed {
+                solver: fdm.as_ref(),
+                speeds_rpm: &speeds,
+                lobes: &lobes,
+            };
             Some(
-                highest_mrr_cut(model, fdm.as_ref(), &speeds, &options)
+                highest_mrr_cut(model, &computed, &speeds, &options)
                     .map_err(|e| ServeError::bad("risk", e.to_string()))?,
             )
         }
@@ -262,16 +276,65 @@ pub fn lobes(model: &ModalModel, request: &LobeRequest, observer: &dyn Observer)
     let finite = |v: f64| v.is_finite().then_some(v);
     Ok(json!({
         "method": "fdm",
-        "lobes": banded.lobes.iter().map(|p| json!([
+        "lobes": lobes.iter().map(|p| json!([
             p.speed_rpm, finite(p.depth_mm()), finite(p.chatter_hz)
         ])).collect::<Vec<_>>(),
         "band_offsets": {"speed_rpm": 100.0, "depth_mm": 0.2},
-        "upper": thin(&banded.bands.upper),
-        "lower": thin(&banded.bands.lower),
+        "upper": thin(&bands.upper),
+        "lower": thin(&bands.lower),
         "recommended": recommendation,
         "max_depth_mm": request.max_depth_mm,
         "risk": request.risk,
     }))
+}
+
+/// A prepared solver whose lobe diagram on `speeds_rpm` is already computed: the
+/// recommendation reads that diagram instead of computing it a second time.
+struct Computed<'a> {
+    solver: &'a dyn PreparedSolver,
+    speeds_rpm: &'a [f64],
+    lobes: &'a [LobePoint],
+}
+
+impl PreparedSolver for Computed<'_> {
+    fn name(&self) -> &'static str {
+        self.solver.name()
+    }
+
+    fn dominant_multiplier(
+        &self,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> chatter_stability::Result<DominantMultiplier> {
+        self.solver.dominant_multiplier(speed_rpm, depth_m)
+    }
+
+    fn chatter_frequency_hz(
+        &self,
+        speed_rpm: f64,
+        depth_m: f64,
+    ) -> chatter_stability::Result<(DominantMultiplier, f64)> {
+        self.solver.chatter_frequency_hz(speed_rpm, depth_m)
+    }
+
+    fn limiting_depth(&self, speed_rpm: f64) -> chatter_stability::Result<LobePoint> {
+        match self.speeds_rpm.iter().position(|&s| s == speed_rpm) {
+            Some(k) => Ok(self.lobes[k]),
+            None => self.solver.limiting_depth(speed_rpm),
+        }
+    }
+
+    fn lobes(
+        &self,
+        speeds_rpm: &[f64],
+        observer: &dyn Observer,
+    ) -> chatter_stability::Result<Vec<LobePoint>> {
+        if speeds_rpm == self.speeds_rpm {
+            Ok(self.lobes.to_vec())
+        } else {
+            self.solver.lobes(speeds_rpm, observer)
+        }
+    }
 }
 
 /// A recording as described on the page.
@@ -459,7 +522,16 @@ pub fn plain_words(d: &chatter_gap::Diagnosis) -> Vec<String> {
                                  logged cuts: check the data, or the machine changed."
             .into(),
     }];
-    for r in d.regions.iter().filter(|r| r.disagreements > 0) {
+    // the three regions where the most observations contradict the model, by share
+    let mut regions: Vec<&chatter_gap::regions::Region> =
+        d.regions.iter().filter(|r| r.disagreements > 0).collect();
+    regions.sort_by(|a, b| {
+        let share = |r: &chatter_gap::regions::Region| {
+            r.disagreements as f64 / r.observations.max(1) as f64
+        };
+        share(b).total_cmp(&share(a))
+    });
+    for r in regions.into_iter().take(3) {
         let range = r
             .range
             .map_or(String::new(), |[a, b]| format!(" ({a:.0} to {b:.0})"));

@@ -80,7 +80,10 @@ fn tap_test_fit_lobes_and_detected_cuts() {
     assert_eq!(modes.len(), 2, "x and y of the symmetric tool: {modes:?}");
 
     // lobes: the diagram, the bands, the recommendation below its own limit
-    let r = get(addr, &format!("/api/setups/{id}/lobes?max_depth_mm=20&risk=0.05"));
+    let r = get(
+        addr,
+        &format!("/api/setups/{id}/lobes?max_depth_mm=20&risk=0.05"),
+    );
     assert_eq!(r.status, 200, "{}", r.body);
     let d = &r.json()["diagram"];
     let lobes = d["lobes"].as_array().unwrap();
@@ -178,7 +181,13 @@ fn bad_uploads_give_a_message_and_store_nothing() {
     let nan_csv: String = csv
         .lines()
         .enumerate()
-        .map(|(i, l)| if i == 40 { "339,NaN,NaN,NaN\n".to_string() } else { format!("{l}\n") })
+        .map(|(i, l)| {
+            if i == 40 {
+                "339,NaN,NaN,NaN\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
         .collect();
     let mut nan_rows = String::from("frequency_hz,real_m_per_n,imag_m_per_n\n");
     for f in 300..400 {
@@ -193,34 +202,180 @@ fn bad_uploads_give_a_message_and_store_nothing() {
     let recording = format!("/api/setups/{id}/recordings");
     let observations = format!("/api/setups/{id}/observations");
     let at_speed = [("speed_rpm", "6000"), ("depth_mm", "2")];
-    let garbage: Vec<u8> = (0..4096u32).map(|i| (i.wrapping_mul(2654435761) >> 24) as u8).collect();
+    let garbage: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 24) as u8)
+        .collect();
     // (what, route, fields, file, a word the message must hold)
     let cases: Vec<(&str, &str, &[(&str, &str)], Option<(&str, Vec<u8>)>, &str)> = vec![
         ("empty FRF", &frf, &[], Some(("tap.csv", vec![])), "empty"),
         ("no file", &frf, &[], None, "no file"),
-        ("wrong type", &frf, &[], Some(("tap.exe", csv.clone().into_bytes())), ".uff"),
-        ("no extension", &frf, &[], Some(("tap", csv.clone().into_bytes())), "must end in"),
-        ("parent path", &frf, &[], Some(("../../etc/passwd.csv", csv.clone().into_bytes())), "plain file name"),
-        ("absolute path", &frf, &[], Some(("/etc/tap.csv", csv.clone().into_bytes())), "plain file name"),
-        ("windows path", &frf, &[], Some(("C:\\data\\tap.csv", csv.clone().into_bytes())), "plain file name"),
-        ("hidden name", &frf, &[], Some((".tap.csv", csv.clone().into_bytes())), "plain file name"),
-        ("huge", &frf, &[], Some(("tap.csv", huge.into_bytes())), "MiB"),
-        ("NaN column", &frf, &[], Some(("tap.csv", nan_rows.into_bytes())), "tap.csv"),
-        ("NaN cells", &frf, &[], Some(("tap.csv", nan_csv.into_bytes())), "tap.csv"),
-        ("truncated UFF", &frf, &[], Some(("tap.uff", uff.as_bytes()[..uff.len() / 2].to_vec())), "tap.uff"),
-        ("binary as CSV", &frf, &[], Some(("tap.csv", garbage.clone())), "UTF-8"),
-        ("header only", &frf, &[], Some(("tap.csv", b"frequency_hz,real_m_per_n,imag_m_per_n\n".to_vec())), "tap.csv"),
-        ("text in numbers", &frf, &[], Some(("tap.txt", b"100 abc 1e-7\n200 1e-7 xyz\n".to_vec())), "tap.txt"),
-        ("bad band", &frf, &[("fmin_hz", "900"), ("fmax_hz", "800")], Some(("tap.csv", csv.clone().into_bytes())), "fmax_hz"),
-        ("broken JSON", &model, &[], Some(("model.json", b"{\"operation\": ".to_vec())), "model.json"),
-        ("negative stiffness", &model, &[], Some(("model.json", negative_model.into_bytes())), "stiffness"),
-        ("model pointing at files", &model, &[], Some(("model.json", measured_only.as_bytes().to_vec())), "model.json"),
-        ("text as WAV", &recording, &at_speed, Some(("cut.wav", csv.clone().into_bytes())), "RIFF"),
-        ("truncated WAV", &recording, &at_speed, Some(("cut.wav", wav[..44].to_vec())), "cut.wav"),
-        ("MP3 garbage", &recording, &at_speed, Some(("cut.mp3", garbage.clone())), "MP3"),
-        ("CSV without rate", &recording, &at_speed, Some(("cut.csv", b"x\n0.1\n0.2\n".to_vec())), "sample rate"),
-        ("recording without speed", &recording, &[("depth_mm", "2")], Some(("cut.wav", wav.clone())), "speed_rpm"),
-        ("negative depth", &observations, &[], Some(("cuts.json", br#"{"cuts": [{"speed_rpm": 5000, "depth_mm": -1, "stable": true}]}"#.to_vec())), "depth_mm"),
+        (
+            "wrong type",
+            &frf,
+            &[],
+            Some(("tap.exe", csv.clone().into_bytes())),
+            ".uff",
+        ),
+        (
+            "no extension",
+            &frf,
+            &[],
+            Some(("tap", csv.clone().into_bytes())),
+            "must end in",
+        ),
+        (
+            "parent path",
+            &frf,
+            &[],
+            Some(("../../etc/passwd.csv", csv.clone().into_bytes())),
+            "plain file name",
+        ),
+        (
+            "absolute path",
+            &frf,
+            &[],
+            Some(("/etc/tap.csv", csv.clone().into_bytes())),
+            "plain file name",
+        ),
+        (
+            "windows path",
+            &frf,
+            &[],
+            Some(("C:\\data\\tap.csv", csv.clone().into_bytes())),
+            "plain file name",
+        ),
+        (
+            "hidden name",
+            &frf,
+            &[],
+            Some((".tap.csv", csv.clone().into_bytes())),
+            "plain file name",
+        ),
+        (
+            "huge",
+            &frf,
+            &[],
+            Some(("tap.csv", huge.into_bytes())),
+            "MiB",
+        ),
+        (
+            "NaN column",
+            &frf,
+            &[],
+            Some(("tap.csv", nan_rows.into_bytes())),
+            "tap.csv",
+        ),
+        (
+            "NaN cells",
+            &frf,
+            &[],
+            Some(("tap.csv", nan_csv.into_bytes())),
+            "tap.csv",
+        ),
+        (
+            "truncated UFF",
+            &frf,
+            &[],
+            Some(("tap.uff", uff.as_bytes()[..uff.len() / 2].to_vec())),
+            "tap.uff",
+        ),
+        (
+            "binary as CSV",
+            &frf,
+            &[],
+            Some(("tap.csv", garbage.clone())),
+            "UTF-8",
+        ),
+        (
+            "header only",
+            &frf,
+            &[],
+            Some((
+                "tap.csv",
+                b"frequency_hz,real_m_per_n,imag_m_per_n\n".to_vec(),
+            )),
+            "tap.csv",
+        ),
+        (
+            "text in numbers",
+            &frf,
+            &[],
+            Some(("tap.txt", b"100 abc 1e-7\n200 1e-7 xyz\n".to_vec())),
+            "tap.txt",
+        ),
+        (
+            "bad band",
+            &frf,
+            &[("fmin_hz", "900"), ("fmax_hz", "800")],
+            Some(("tap.csv", csv.clone().into_bytes())),
+            "fmax_hz",
+        ),
+        (
+            "broken JSON",
+            &model,
+            &[],
+            Some(("model.json", b"{\"operation\": ".to_vec())),
+            "model.json",
+        ),
+        (
+            "negative stiffness",
+            &model,
+            &[],
+            Some(("model.json", negative_model.into_bytes())),
+            "stiffness",
+        ),
+        (
+            "model pointing at files",
+            &model,
+            &[],
+            Some(("model.json", measured_only.as_bytes().to_vec())),
+            "model.json",
+        ),
+        (
+            "text as WAV",
+            &recording,
+            &at_speed,
+            Some(("cut.wav", csv.clone().into_bytes())),
+            "RIFF",
+        ),
+        (
+            "truncated WAV",
+            &recording,
+            &at_speed,
+            Some(("cut.wav", wav[..44].to_vec())),
+            "cut.wav",
+        ),
+        (
+            "MP3 garbage",
+            &recording,
+            &at_speed,
+            Some(("cut.mp3", garbage.clone())),
+            "MP3",
+        ),
+        (
+            "CSV without rate",
+            &recording,
+            &at_speed,
+            Some(("cut.csv", b"x\n0.1\n0.2\n".to_vec())),
+            "sample rate",
+        ),
+        (
+            "recording without speed",
+            &recording,
+            &[("depth_mm", "2")],
+            Some(("cut.wav", wav.clone())),
+            "speed_rpm",
+        ),
+        (
+            "negative depth",
+            &observations,
+            &[],
+            Some((
+                "cuts.json",
+                br#"{"cuts": [{"speed_rpm": 5000, "depth_mm": -1, "stable": true}]}"#.to_vec(),
+            )),
+            "depth_mm",
+        ),
     ];
     assert!(cases.len() >= 20);
     for (what, route, fields, file, word) in &cases {
@@ -286,9 +441,15 @@ fn twenty_concurrent_clients_get_their_lobes() {
         let model = if k == 0 {
             chatter_dynamics::examples::SCHMITZ_2023_MILLING_MODEL.to_string()
         } else {
-            chatter_dynamics::examples::SCHMITZ_2023_MILLING_MODEL.replace("750.0, \"damping", "800.0, \"damping")
+            chatter_dynamics::examples::SCHMITZ_2023_MILLING_MODEL
+                .replace("750.0, \"damping", "800.0, \"damping")
         };
-        let r = post_form(addr, &format!("/api/setups/{id}/model"), &[], Some(("m.json", model.as_bytes())));
+        let r = post_form(
+            addr,
+            &format!("/api/setups/{id}/model"),
+            &[],
+            Some(("m.json", model.as_bytes())),
+        );
         assert_eq!(r.status, 200, "{}", r.body);
     }
     let started = std::time::Instant::now();
