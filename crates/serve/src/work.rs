@@ -29,7 +29,7 @@ fn thin<T: Copy>(points: &[T]) -> Vec<T> {
     let step = points.len().div_ceil(CURVE_POINTS).max(1);
     let mut out: Vec<T> = points.iter().step_by(step).copied().collect();
     if let Some(&last) = points.last()
-        && (points.len() - 1) % step != 0
+        && !(points.len() - 1).is_multiple_of(step)
     {
         out.push(last);
     }

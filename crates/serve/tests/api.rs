@@ -206,7 +206,14 @@ fn bad_uploads_give_a_message_and_store_nothing() {
         .map(|i| (i.wrapping_mul(2654435761) >> 24) as u8)
         .collect();
     // (what, route, fields, file, a word the message must hold)
-    let cases: Vec<(&str, &str, &[(&str, &str)], Option<(&str, Vec<u8>)>, &str)> = vec![
+    type Case<'a> = (
+        &'a str,
+        &'a str,
+        &'a [(&'a str, &'a str)],
+        Option<(&'a str, Vec<u8>)>,
+        &'a str,
+    );
+    let cases: Vec<Case> = vec![
         ("empty FRF", &frf, &[], Some(("tap.csv", vec![])), "empty"),
         ("no file", &frf, &[], None, "no file"),
         (
