@@ -147,8 +147,8 @@ fn whole_workflow_in_headless_chromium() {
     std::fs::create_dir_all(&shots).unwrap();
     let tap = dir.path().join("tap_x.uff");
     std::fs::write(&tap, tap_test_uff()).unwrap();
-    let recording = dir.path().join("cut_7000rpm.wav");
-    std::fs::write(&recording, recording_wav(7000.0, Some(812.5))).unwrap();
+    let recording = dir.path().join("cut_6000rpm.wav");
+    std::fs::write(&recording, recording_wav(6000.0, Some(812.5))).unwrap();
     let bad = dir.path().join("photo.exe");
     std::fs::write(&bad, b"MZ not a tap test").unwrap();
     let data = dir.path().join("data");

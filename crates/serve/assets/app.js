@@ -439,6 +439,7 @@ function upload(formId, path, button, done) {
 document.querySelectorAll("#tabs button").forEach(b => b.addEventListener("click", () => {
   document.querySelectorAll("#tabs button").forEach(x => x.classList.toggle("active", x === b));
   document.querySelectorAll(".screen").forEach(s => { s.hidden = s.id !== "screen-" + b.dataset.screen; });
+  show("");
 }));
 
 document.getElementById("setup-select").addEventListener("change", ev => run(async () => {

@@ -590,3 +590,49 @@ fn insert_file(t: &rusqlite::Transaction, setup_id: i64, f: &StoredFile) -> Resu
     )?;
     Ok(t.last_insert_rowid())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn migrations_apply_once_and_running_jobs_fail_on_reopen() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("chatter.sqlite");
+        let db = Db::open(&path).unwrap();
+        assert_eq!(db.schema_version().unwrap(), MIGRATIONS.len() as i64);
+        let setup = db
+            .add_setup("s", "m", "t", "h", &serde_json::json!({}))
+            .unwrap();
+        let running = db
+            .start_job(setup, "learn", &serde_json::json!({}))
+            .unwrap();
+        let finished = db
+            .start_job(setup, "learn", &serde_json::json!({}))
+            .unwrap();
+        db.finish_job(finished, "done", Some(&serde_json::json!({"k": 1})), None)
+            .unwrap();
+        drop(db);
+        let db = Db::open(&path).unwrap();
+        assert_eq!(db.schema_version().unwrap(), MIGRATIONS.len() as i64);
+        let j = db.job(running).unwrap();
+        assert_eq!(
+            (j.status.as_str(), j.error.as_deref()),
+            ("failed", Some(INTERRUPTED))
+        );
+        assert_eq!(db.job(finished).unwrap().status, "done");
+        assert_eq!(db.setups().unwrap().len(), 1);
+    }
+
+    #[test]
+    fn a_newer_schema_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("chatter.sqlite");
+        Connection::open(&path)
+            .unwrap()
+            .pragma_update(None, "user_version", 99)
+            .unwrap();
+        let e = Db::open(&path).unwrap_err().to_string();
+        assert!(e.contains("schema version 99"), "{e}");
+    }
+}

@@ -70,6 +70,18 @@ impl ServeOptions {
 }
 
 /// The warning a non-loopback address deserves, None for a loopback one.
+///
+/// ```
+/// use chatter_serve::{ServeOptions, exposure_warning};
+/// let everywhere = ServeOptions::new("0.0.0.0", 8080, "data".into(), false)?;
+/// assert!(exposure_warning(everywhere.host).is_some_and(|w| w.contains("network")));
+/// let local = ServeOptions::new("127.0.0.1", 8080, "data".into(), false)?;
+/// assert!(exposure_warning(local.host).is_none());
+/// // a host name is refused, naming the option
+/// let e = ServeOptions::new("example.org", 8080, "data".into(), false).unwrap_err();
+/// assert!(e.to_string().starts_with("--host"));
+/// # Ok::<(), chatter_serve::ServeError>(())
+/// ```
 pub fn exposure_warning(host: IpAddr) -> Option<String> {
     (!host.is_loopback()).then(|| {
         format!(

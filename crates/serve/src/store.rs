@@ -181,19 +181,6 @@ impl DataDir {
         self.root.join("chatter.sqlite")
     }
 
-    /// The path of a stored file: `stored_name` must be a name this folder generated.
-    pub fn file(&self, stored_name: &str) -> Result<PathBuf> {
-        if stored_name.is_empty()
-            || !stored_name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '.')
-            || stored_name.starts_with('.')
-        {
-            return Err(ServeError::NotFound(format!("file {stored_name}")));
-        }
-        Ok(self.root.join("files").join(stored_name))
-    }
-
     /// Write `bytes` under `tmp/` by a generated name with `extension`.
     pub fn stage(&self, kind: UploadKind, extension: &str, bytes: &[u8]) -> Result<Staged> {
         let nanos = std::time::SystemTime::now()

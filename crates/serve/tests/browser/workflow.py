@@ -84,8 +84,8 @@ with sync_playwright() as p:
 
     # 3. cut log: the proposed cut's recording judged
     page.click("#tabs button[data-screen=cuts]")
-    # the proposal filled speed and depth; the recording at hand was made at 7000 rpm
-    page.fill("#recording-form input[name=speed_rpm]", "7000")
+    # the proposal filled speed and depth; the recording at hand was made at 6000 rpm
+    page.fill("#recording-form input[name=speed_rpm]", "6000")
     page.set_input_files("#recording-form input[name=file]", recording)
     page.click("#judge-button")
     message(page, "ok", "recording judged")
