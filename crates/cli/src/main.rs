@@ -358,6 +358,21 @@ enum Command {
     /// Diagnose and plan every machine-tool campaign of a fleet manifest in parallel: one table
     /// row per campaign (verdict, boundary shift, next test).
     Batch(batch::BatchArgs),
+    /// The shop-floor web application: setups, tap tests, lobes, cut log, learning, export.
+    Serve {
+        /// Address to listen on; another than 127.0.0.1 exposes the data to the network.
+        #[arg(long, default_value = "127.0.0.1")]
+        host: String,
+        /// Port (0: any free one, printed).
+        #[arg(long, default_value_t = 8080)]
+        port: u16,
+        /// Data folder: the database and the uploaded files (created if needed).
+        #[arg(long, default_value = "chatter-data")]
+        data: PathBuf,
+        /// Add the example setup (seed 001's mill with its cut log) if it is not there.
+        #[arg(long)]
+        example: bool,
+    },
     /// Run the main job on the embedded examples and write the results to a folder.
     Demo {
         /// Output folder.
@@ -614,6 +629,20 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Rcsa(args) => rcsa::rcsa(&args),
         Command::Batch(args) => batch::run(&args, quiet),
         Command::Demo { out } => commands::demo(&out, quiet),
+        Command::Serve {
+            host,
+            port,
+            data,
+            example,
+        } => {
+            let options = chatter_serve::ServeOptions::new(&host, port, data, example)?;
+            if let Some(w) = chatter_serve::exposure_warning(options.host) {
+                eprintln!("warning: {w}");
+            }
+            Ok(chatter_serve::serve(&options, |a| {
+                println!("chatter serve: listening on http://{a}/ (Ctrl-C stops)");
+            })?)
+        }
     }
 }
 
