@@ -4,6 +4,9 @@
 //! same request gives the same numbers bit for bit; they differ only in how they parse and
 //! write.
 //!
+//! - [`lobes`]: limiting depths per speed (modes or measured FRFs) and the |mu| map.
+//! - [`multiplier`]: the dominant multiplier of one cut and the stability rule |mu| < 1.
+//! - [`checks`]: the checks every request runs once (ranges, the cost guard, ignored options).
 //! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
 //! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]), also from recordings.
 //! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
@@ -19,10 +22,13 @@
 
 pub mod bands;
 pub mod campaign;
+pub mod checks;
 pub mod detect;
 pub mod diagnose;
 pub mod error;
 pub mod inference_data;
+pub mod lobes;
+pub mod multiplier;
 pub mod oma;
 pub mod plan;
 pub mod recordings;
