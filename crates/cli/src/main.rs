@@ -6,12 +6,12 @@
 mod bands;
 mod batch;
 mod commands;
+mod demo;
 mod detect;
 mod diagnose;
 mod inputs;
 mod lobe_map;
 mod measured;
-mod measured_bands;
 mod oma;
 mod output;
 mod papers;
@@ -22,6 +22,7 @@ mod rcsa;
 mod report;
 mod sensitivity;
 mod shop;
+mod tables;
 mod update;
 mod validate;
 
@@ -394,25 +395,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out,
             plot,
         } => {
-            let range = match (fmin_hz, fmax_hz) {
-                (None, None) => None,
-                (a, Some(b)) => Some((
-                    validate::option("--fmin-hz", a.unwrap_or(0.0), &validate::FRF_HZ)?,
-                    validate::option("--fmax-hz", b, &validate::FRF_HZ)?,
-                )),
-                (Some(a), None) => anyhow::bail!(
-                    "--fmin-hz {} needs --fmax-hz",
-                    validate::as_typed("--fmin-hz", a)
-                ),
-            };
-            validate::count("--points", points, 2, validate::MAX_POINTS, "frequencies")?;
             output::check_optional_file("--out", out.as_deref())?;
             output::check_optional_file("--plot", plot.as_deref())?;
             commands::frf(
                 &model,
-                range,
-                points,
-                (from, to),
+                &chatter_jobs::frf::FrfRequest {
+                    fmin_hz,
+                    fmax_hz,
+                    points,
+                    response: from,
+                    force: to,
+                },
                 out.as_deref(),
                 plot.as_deref(),
             )
@@ -489,12 +482,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             ssv_frequency_ratio,
         } => commands::multiplier(
             &model,
-            validate::option(
-                "--speed-rpm",
-                speed_rpm,
-                &chatter_dynamics::limits::SPEED_RPM,
-            )?,
-            validate::option("--depth-mm", depth_mm, &chatter_dynamics::limits::DEPTH_MM)?,
+            speed_rpm,
+            depth_mm,
             method,
             shop::speed_variation(ssv_amplitude_ratio, ssv_frequency_ratio)?,
             quiet,
@@ -613,7 +602,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::FitFrf(args) => measured::fit_frf(&args),
         Command::Rcsa(args) => rcsa::rcsa(&args),
         Command::Batch(args) => batch::run(&args, quiet),
-        Command::Demo { out } => commands::demo(&out, quiet),
+        Command::Demo { out } => demo::demo(&out, quiet),
     }
 }
 
@@ -640,17 +629,83 @@ fn command() -> clap::Command {
     })
 }
 
-/// A job's error in the command line's words: an invalid request field is reported as its
-/// option (`samples` as `--samples`), the rest as it is.
+/// A job's error in the command line's words: a request field is reported as its option
+/// (`samples` as `--samples`, the value echoed as typed), and the fields the job's messages
+/// quote in backticks likewise (`` `kind` geometric `` as `--kind geometric`); the rest as it is.
 pub fn job_error(e: chatter_jobs::JobError) -> anyhow::Error {
+    use chatter_jobs::JobError;
     match e {
-        chatter_jobs::JobError::Invalid {
+        JobError::Invalid {
             field,
             value,
             expected,
-        } => anyhow::anyhow!("--{} {value}: expected {expected}", field.replace('_', "-")),
+        } => {
+            let flag = flag(field);
+            let value = match value.parse::<f64>() {
+                Ok(v) => validate::as_typed(&flag, v),
+                Err(_) => value,
+            };
+            anyhow::anyhow!("{flag} {value}: expected {}", flags(&expected))
+        }
+        JobError::Unused {
+            field,
+            context,
+            used_by,
+        } => anyhow::anyhow!(
+            "{} is not used {}; it is for {}",
+            flag(field),
+            flags(&context),
+            flags(&used_by)
+        ),
+        JobError::TooManySteps { ref field, .. } => {
+            let text = e.to_string();
+            let source = if is_field(field) {
+                flag(field)
+            } else {
+                field.clone()
+            };
+            anyhow::anyhow!(
+                "{source}{}",
+                flags(&text[field.len()..]).replace("where the job offers", "where the command offers")
+            )
+        }
+        JobError::Refused(_) | JobError::Missing { .. } => anyhow::anyhow!("{}", flags(&e.to_string())),
         other => other.into(),
     }
+}
+
+/// Whether `name` is a request field (lower-case words joined by `_`).
+fn is_field(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// The option of request field `field` (`offset_rpm` -> `--offset-rpm`).
+fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
+/// `text` with every field quoted in backticks written as its option.
+fn flags(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(open) = rest.find('`') {
+        let Some(close) = rest[open + 1..].find('`') else {
+            break;
+        };
+        let inner = &rest[open + 1..open + 1 + close];
+        out.push_str(&rest[..open]);
+        if is_field(inner) {
+            out.push_str(&flag(inner));
+        } else {
+            out.push_str(&rest[open..open + close + 2]);
+        }
+        rest = &rest[open + close + 2..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// The error and its causes on one line, each cause once: a cause whose text its parent

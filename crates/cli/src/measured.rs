@@ -1,65 +1,13 @@
-//! Measured FRFs in the CLI: `chatter lobes --method zoa` on a model whose `measured_frf` gives
-//! its dynamics, and `chatter fit-frf` (modal fit, model file, overlay plot).
+//! `chatter fit-frf`: modal fit of a measured FRF, model file, overlay plot.
 
-use crate::commands::Method;
 use crate::output::write_atomic;
 use crate::plot::{Series, line_chart};
 use anyhow::{Context, Result, bail};
 use chatter_dynamics::ModelFile;
 use chatter_dynamics::model_file::{ModeFile, ResidualFile};
-use chatter_frf::{FitOptions, MeasuredModel, ModalFit, fit_modes, read_frf, read_model_file};
-use chatter_stability::boundary::LobePoint;
-use chatter_stability::zero_order::{ZeroOrderOptions, measured_limiting_depths};
+use chatter_frf::{FitOptions, ModalFit, fit_modes, read_frf, read_model_file};
 use plotters::style::{BLUE, GREEN, RED};
-use std::path::{Path, PathBuf};
-
-/// Zero-order lobes from the model's measured FRFs when it has them: None for a modal model;
-/// an error for other methods on a model without modes.
-pub fn lobes(
-    model_path: &Path,
-    method: Method,
-    speeds: Option<&str>,
-) -> Result<Option<Vec<LobePoint>>> {
-    let file = read_model_file(model_path).context("reading the model file")?;
-    if file.measured_frf.is_none() {
-        return Ok(None);
-    }
-    if method != Method::Zoa {
-        if file.modes.is_empty() {
-            bail!(
-                "{}: --method {} needs modal parameters, and this model gives its dynamics as \
-                 measured_frf only; use --method zoa (zero-order lobes straight from the FRF), or \
-                 fit modes with `chatter fit-frf` and add them as `modes`",
-                model_path.display(),
-                format!("{method:?}").to_lowercase()
-            );
-        }
-        // a model with both: the modes serve the time-domain methods
-        return Ok(None);
-    }
-    let model = MeasuredModel::from_path(model_path).context("reading the measured FRFs")?;
-    let speeds = match speeds {
-        Some(s) => crate::validate::speeds(s)?,
-        None => default_speeds(&model),
-    };
-    Ok(Some(measured_limiting_depths(
-        &model.operation,
-        model.cutting,
-        &model.receptance,
-        &speeds,
-        // the depth ceiling of every `lobes` method (see `commands::warn_unbounded`)
-        &ZeroOrderOptions::default(),
-    )?))
-}
-
-/// The default speeds around the receptance's peak
-/// (`chatter_stability::speed_grid::even_lobe_speeds_rpm`).
-pub fn default_speeds(model: &MeasuredModel) -> Vec<f64> {
-    chatter_stability::speed_grid::even_lobe_speeds_rpm(
-        model.receptance.peak_frequency_hz(),
-        model.operation.delays_per_revolution() as f64,
-    )
-}
+use std::path::PathBuf;
 
 /// Arguments of `chatter fit-frf`.
 #[derive(Debug, clap::Args)]
@@ -146,8 +94,8 @@ fn mode_entries(fit: &ModalFit, complex: bool, direction: &str) -> Result<Vec<Mo
 
 /// `chatter fit-frf`: prints the fit report (complex modes, residual terms, misfits) as JSON.
 pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
-    let fmin = crate::validate::option("--fmin-hz", args.fmin_hz, &crate::validate::FRF_HZ)?;
-    let fmax = crate::validate::option("--fmax-hz", args.fmax_hz, &crate::validate::FRF_HZ)?;
+    let fmin = crate::validate::option("--fmin-hz", args.fmin_hz, &chatter_jobs::frf::FRF_HZ)?;
+    let fmax = crate::validate::option("--fmax-hz", args.fmax_hz, &chatter_jobs::frf::FRF_HZ)?;
     if fmax <= fmin {
         bail!(
             "--fmax-hz {}: expected above --fmin-hz {}",

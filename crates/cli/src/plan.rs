@@ -172,7 +172,7 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     let depths = args
         .depths
         .as_deref()
-        .map(|s| validate::grid("--depths", s, &validate::DEPTH_GRID_MM))
+        .map(|s| validate::grid("--depths", s, &chatter_jobs::checks::DEPTH_GRID_MM))
         .transpose()?;
     let model = crate::inputs::model(&args.model)?;
     let observations = match &args.observations {

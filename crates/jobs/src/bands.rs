@@ -465,10 +465,10 @@ impl<'a> Bands<'a> {
         if !geometric {
             request.rule()?;
             if distribution.is_none() {
-                return Err(JobError::Refused(format!(
-                    "`kind` {} needs a parameter distribution",
-                    request.kind.name()
-                )));
+                return Err(JobError::Missing {
+                    what: "a parameter distribution",
+                    needed_by: format!("`kind` {}", request.kind.name()),
+                });
             }
             if request.method().discretization().is_none() {
                 return Err(JobError::Refused(format!(

@@ -74,7 +74,7 @@ pub fn work_size(
     model: &ModalModel,
     method: Discretization,
     speeds_rpm: &[f64],
-    field: &'static str,
+    field: &str,
 ) -> Result<()> {
     let Some(&slowest) = speeds_rpm.iter().min_by(|a, b| a.total_cmp(b)) else {
         return Ok(());

@@ -23,6 +23,14 @@ pub enum JobError {
         /// What uses it.
         used_by: String,
     },
+    /// An input the job needs was not given.
+    #[error("{needed_by} needs {what}")]
+    Missing {
+        /// What is missing ("a parameter distribution").
+        what: &'static str,
+        /// What needs it (`` `kind` perturbation ``).
+        needed_by: String,
+    },
     /// Two fields that exclude each other, or a combination the job cannot do.
     #[error("{0}")]
     Refused(String),

@@ -6,6 +6,7 @@
 //!
 //! - [`lobes`]: limiting depths per speed (modes or measured FRFs) and the |mu| map.
 //! - [`multiplier`]: the dominant multiplier of one cut and the stability rule |mu| < 1.
+//! - [`frf`]: the receptance of a modal model on a frequency grid.
 //! - [`checks`]: the checks every request runs once (ranges, the cost guard, ignored options).
 //! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
 //! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]), also from recordings.
@@ -15,6 +16,7 @@
 //! - [`detect`]: chatter detection of a signal record, as a labelled cut with its evidence.
 //! - [`recordings`]: a shop's recordings to labelled cuts and identified poles, one row per
 //!   record.
+//! - [`synthetic`]: the synthetic shop-floor campaign of the proving ground (demo and Python).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
 //! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
 
@@ -26,12 +28,14 @@ pub mod checks;
 pub mod detect;
 pub mod diagnose;
 pub mod error;
+pub mod frf;
 pub mod inference_data;
 pub mod lobes;
 pub mod multiplier;
 pub mod oma;
 pub mod plan;
 pub mod recordings;
+pub mod synthetic;
 pub mod update;
 
 pub use error::{JobError, Result};

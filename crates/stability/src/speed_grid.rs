@@ -13,6 +13,7 @@
 
 use crate::boundary::dominant_mode_frequency_hz;
 use chatter_dynamics::ModalModel;
+use chatter_dynamics::grid::evenly_spaced;
 
 /// Speeds per unit lobe number of [`lobe_speeds_rpm`].
 pub const POINTS_PER_LOBE: f64 = 20.0;
@@ -45,13 +46,6 @@ pub fn default_speeds_rpm(model: &ModalModel) -> Vec<f64> {
         dominant_mode_frequency_hz(model),
         model.operation().delays_per_revolution() as f64,
     )
-}
-
-/// `n >= 2` evenly spaced values from `min` to `max` inclusive.
-pub(crate) fn evenly_spaced(min: f64, max: f64, n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| min + (max - min) * i as f64 / (n - 1) as f64)
-        .collect()
 }
 
 /// `count` depths from 1 / `count` to [`DEPTH_GRID_TOP`] times `deepest` (in the unit of
