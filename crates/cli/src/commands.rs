@@ -9,7 +9,7 @@ use anyhow::{Context, Result, bail};
 use chatter_jobs::frf::FrfRequest;
 use chatter_jobs::lobes::{Dynamics, Lobes, LobesRequest};
 use chatter_jobs::multiplier::{Multiplier, MultiplierRequest};
-pub use chatter_stability::prepared::Method;
+use chatter_stability::prepared::Method;
 use plotters::style::BLUE;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -63,7 +63,7 @@ pub struct PlanArgs {
     /// Stability method of the sampled boundaries: fdm (default), sdm, or zoa (the
     /// zero-order method 004 used; complex modes need it).
     #[arg(long, value_enum)]
-    method: Option<crate::commands::Method>,
+    method: Option<chatter_stability::prepared::Method>,
     /// Seed of the prior samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,

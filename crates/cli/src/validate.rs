@@ -222,6 +222,85 @@ pub fn posterior_matches(model: &ModalModel, dir: &std::path::Path) -> Result<()
     Ok(())
 }
 
+/// A job's error in the command line's words: a request field is reported as its option
+/// (`samples` as `--samples`, the value echoed as typed), and the fields the job's messages
+/// quote in backticks likewise (`` `kind` geometric `` as `--kind geometric`); the rest as it is.
+pub fn job_error(e: chatter_jobs::JobError) -> anyhow::Error {
+    use chatter_jobs::JobError;
+    match e {
+        JobError::Invalid {
+            field,
+            value,
+            expected,
+        } => {
+            let flag = flag(field);
+            let value = match value.parse::<f64>() {
+                Ok(v) => as_typed(&flag, v),
+                Err(_) => value,
+            };
+            anyhow::anyhow!("{flag} {value}: expected {}", flags(&expected))
+        }
+        JobError::Unused {
+            field,
+            context,
+            used_by,
+        } => anyhow::anyhow!(
+            "{} is not used {}; it is for {}",
+            flag(field),
+            flags(&context),
+            flags(&used_by)
+        ),
+        JobError::TooManySteps { ref field, .. } => {
+            let text = e.to_string();
+            let source = if is_field(field) {
+                flag(field)
+            } else {
+                field.clone()
+            };
+            anyhow::anyhow!(
+                "{source}{}",
+                flags(&text[field.len()..]).replace("where the job offers", "where the command offers")
+            )
+        }
+        JobError::Refused(_) | JobError::Missing { .. } => anyhow::anyhow!("{}", flags(&e.to_string())),
+        other => other.into(),
+    }
+}
+
+/// Whether `name` is a request field (lower-case words joined by `_`).
+fn is_field(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// The option of request field `field` (`offset_rpm` -> `--offset-rpm`).
+fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
+/// `text` with every field quoted in backticks written as its option.
+fn flags(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(open) = rest.find('`') {
+        let Some(close) = rest[open + 1..].find('`') else {
+            break;
+        };
+        let inner = &rest[open + 1..open + 1 + close];
+        out.push_str(&rest[..open]);
+        if is_field(inner) {
+            out.push_str(&flag(inner));
+        } else {
+            out.push_str(&rest[open..open + close + 2]);
+        }
+        rest = &rest[open + close + 2..];
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,6 +6,7 @@
 //!
 //! - [`lobes`]: limiting depths per speed (modes or measured FRFs) and the |mu| map.
 //! - [`multiplier`]: the dominant multiplier of one cut and the stability rule |mu| < 1.
+//! - [`fit_frf`]: modes fitted to a measured FRF, merged into a model file.
 //! - [`frf`]: the receptance of a modal model on a frequency grid.
 //! - [`checks`]: the checks every request runs once (ranges, the cost guard, ignored options).
 //! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
@@ -28,6 +29,7 @@ pub mod checks;
 pub mod detect;
 pub mod diagnose;
 pub mod error;
+pub mod fit_frf;
 pub mod frf;
 pub mod inference_data;
 pub mod lobes;
