@@ -179,9 +179,9 @@ fn method_of(name: &str) -> PyResult<Method> {
     }
 }
 
-/// The speeds array as a request field (`None`: the request's default speeds).
-fn speeds_of(speeds_rpm: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<Vec<f64>>> {
-    Ok(speeds_rpm.map(|s| s.as_slice().map(<[f64]>::to_vec)).transpose()?)
+/// An optional array as a request field (`None`: the request's default).
+fn vec_of(values: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<Vec<f64>>> {
+    Ok(values.map(|s| s.as_slice().map(<[f64]>::to_vec)).transpose()?)
 }
 
 fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
@@ -259,7 +259,7 @@ fn lobes<'py>(
     let dynamics = Dynamics::Modal(model_of(model)?);
     let request = LobesRequest {
         method: method_of(method)?,
-        speeds_rpm: speeds_of(speeds_rpm)?,
+        speeds_rpm: vec_of(speeds_rpm)?,
         ..LobesRequest::default()
     };
     let points = run_detached(py, move |observer| {
@@ -367,7 +367,7 @@ fn bands_geometric<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = BandsRequest {
         method: Some(method_of(method)?),
-        speeds_rpm: speeds_of(speeds_rpm)?,
+        speeds_rpm: vec_of(speeds_rpm)?,
         offset_rpm,
         offset_mm,
         ..BandsRequest::new(BandKind::Geometric)
@@ -473,10 +473,8 @@ fn bands_perturbation<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = BandsRequest {
         method: Some(method_of(method)?),
-        speeds_rpm: speeds_of(speeds_rpm)?,
-        depths_mm: depths_mm
-            .map(|d| d.as_slice().map(<[f64]>::to_vec))
-            .transpose()?,
+        speeds_rpm: vec_of(speeds_rpm)?,
+        depths_mm: vec_of(depths_mm)?,
         coverage,
         ..BandsRequest::new(BandKind::Perturbation)
     };
@@ -525,10 +523,8 @@ fn bands_montecarlo<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = BandsRequest {
         method: Some(method_of(method)?),
-        speeds_rpm: speeds_of(speeds_rpm)?,
-        depths_mm: map_depths_mm
-            .map(|d| d.as_slice().map(<[f64]>::to_vec))
-            .transpose()?,
+        speeds_rpm: vec_of(speeds_rpm)?,
+        depths_mm: vec_of(map_depths_mm)?,
         samples,
         seed,
         map: true,
@@ -599,25 +595,28 @@ fn simulate<'py>(
     harmonic_force_n: f64,
     feed_per_tooth_mm: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use chatter_dynamics::simulate::{Quantity, SimulationSettings};
+    use chatter_dynamics::simulate::Quantity;
+    use chatter_jobs::simulate::SimulateRequest;
     let m = model_of(model)?;
-    let mut s =
-        SimulationSettings::new(speed_rpm, depth_mm * 1e-3, duration_s, sample_rate_hz, seed);
-    s.quantity = match quantity {
-        "acceleration" => Quantity::Acceleration,
-        "velocity" => Quantity::Velocity,
-        "displacement" => Quantity::Displacement,
-        other => {
-            return Err(value_error(format!(
-                "quantity {other:?}: expected \"acceleration\", \"velocity\" or \"displacement\""
-            )));
-        }
+    let request = SimulateRequest {
+        quantity: match quantity {
+            "acceleration" => Quantity::Acceleration,
+            "velocity" => Quantity::Velocity,
+            "displacement" => Quantity::Displacement,
+            other => {
+                return Err(value_error(format!(
+                    "quantity {other:?}: expected \"acceleration\", \"velocity\" or \"displacement\""
+                )));
+            }
+        },
+        random_force_n,
+        harmonic_force_n,
+        feed_per_tooth_mm,
+        ..SimulateRequest::new(speed_rpm, depth_mm, duration_s, sample_rate_hz, seed)
     };
-    s.random_force_rms_n = random_force_n;
-    s.harmonic_force_n = harmonic_force_n;
-    s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
+    let s = request.check().map_err(value_error)?;
     let sim = run_detached(py, move |observer| {
-        chatter_dynamics::simulate::simulate_with_observer(&m, &s, observer)
+        chatter_jobs::simulate::simulate(&m, &s, observer)
     })?
     .map_err(value_error)?;
     let names: Vec<String> = sim.channels.iter().map(|c| c.name.clone()).collect();
@@ -976,12 +975,8 @@ fn plan<'py>(
     request.method = optional_method(method)?;
     request.target = target.map(|t| t.parse().map_err(value_error)).transpose()?;
     request.paths = paths;
-    request.speeds_rpm = speeds_rpm
-        .map(|s| s.as_slice().map(<[f64]>::to_vec))
-        .transpose()?;
-    request.depths_mm = depths_mm
-        .map(|s| s.as_slice().map(<[f64]>::to_vec))
-        .transpose()?;
+    request.speeds_rpm = vec_of(speeds_rpm)?;
+    request.depths_mm = vec_of(depths_mm)?;
     request.feed_per_tooth_mm = feed_per_tooth_mm;
     request.seed = seed;
     request.max_tests = max_tests;

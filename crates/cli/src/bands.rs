@@ -139,6 +139,8 @@ fn request(req: &BandRequest) -> Result<BandsRequest> {
 pub fn bands(req: &BandRequest) -> Result<()> {
     check_outputs(req)?;
     let request = request(req)?;
+    // the options before the files: a misplaced option is named even when a file is the wrong kind
+    request.check().map_err(crate::job_error)?;
     let dynamics = inputs::dynamics(req.model, request.method())?;
     let model = match &dynamics {
         Dynamics::Modal(m) => Some(m),
@@ -441,4 +443,3 @@ pub fn rule_title(rule: BoundRule) -> String {
         BoundRule::Coverage(c) => format!("{:.0} % credibility of |mu|", 100.0 * c),
     }
 }
-

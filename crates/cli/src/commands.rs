@@ -148,7 +148,10 @@ pub fn lobes(
                 "Dominant multiplier |mu| ({}): blue stable, red chatter, black the limit",
                 method.name()
             );
-            write_atomic(p, crate::lobe_map::heat_map_svg(&title, m, &lobes)?.as_bytes())?;
+            write_atomic(
+                p,
+                crate::lobe_map::heat_map_svg(&title, m, &lobes)?.as_bytes(),
+            )?;
         }
     }
     emit(out, &tables::lobes_csv(&lobes))?;
@@ -270,7 +273,7 @@ pub fn simulate(
         settings.speed_rpm,
         (settings.duration_s * settings.sample_rate_hz).round()
     ));
-    let sim = chatter_dynamics::simulate::simulate_with_observer(&model, settings, &bar)?;
+    let sim = chatter_jobs::simulate::simulate(&model, settings, &bar).map_err(crate::job_error)?;
     bar.finish();
     let is_wav = out
         .extension()

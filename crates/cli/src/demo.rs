@@ -20,7 +20,12 @@ use std::path::Path;
 pub use crate::report::jobs::CREDIBILITY_TITLE;
 
 /// The limiting depths of `model` by `method` at `speeds_rpm` (the lobe job).
-fn lobes(model: &ModalModel, method: Method, speeds_rpm: Vec<f64>, quiet: bool) -> Result<Vec<LobePoint>> {
+fn lobes(
+    model: &ModalModel,
+    method: Method,
+    speeds_rpm: Vec<f64>,
+    quiet: bool,
+) -> Result<Vec<LobePoint>> {
     let dynamics = Dynamics::Modal(model.clone());
     let request = LobesRequest {
         method,
@@ -112,7 +117,10 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     let updated = dist.mean_model(&turning)?;
     let coarse: Vec<f64> = (0..=36).map(|i| 6800.0 + 25.0 * i as f64).collect();
     let updated_lobes = lobes(&updated, Method::Fdm, coarse.clone(), quiet)?;
-    let depths = lobe_covering_depths(&updated_lobes)?;
+    let Some(depths) = chatter_stability::speed_grid::covering_depths_mm(&updated_lobes, 0.025)
+    else {
+        bail!("no finite limiting depth to cover");
+    };
     let rule = chatter_uncertainty::perturbation::BoundRule::ComplexSd;
     let credibility = chatter_jobs::bands::perturbation(
         &turning,
@@ -246,9 +254,24 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     let page = crate::report::jobs::demo(
         &folder,
         &[
-            ("Turning tool of Ahmadi (2022) (FDM lobes)", BandCurves::of_lobes(&fdm), "", crate::report::jobs::LOBES_MISSING),
-            ("Turning tool of Ahmadi (2022) after updating (credibility bounds)", BandCurves::of_credibility(&credibility.bounds), "lower credibility bound", crate::report::jobs::PERTURBATION_MISSING),
-            ("Milling example of Schmitz (2023) (offsets 100 rpm, 0.2 mm)", BandCurves::of_offsets(&bands), "lower offset boundary", crate::report::jobs::GEOMETRIC_MISSING),
+            (
+                "Turning tool of Ahmadi (2022) (FDM lobes)",
+                BandCurves::of_lobes(&fdm),
+                "",
+                crate::report::jobs::LOBES_MISSING,
+            ),
+            (
+                "Turning tool of Ahmadi (2022) after updating (credibility bounds)",
+                BandCurves::of_credibility(&credibility.bounds),
+                "lower credibility bound",
+                crate::report::jobs::PERTURBATION_MISSING,
+            ),
+            (
+                "Milling example of Schmitz (2023) (offsets 100 rpm, 0.2 mm)",
+                BandCurves::of_offsets(&bands),
+                "lower offset boundary",
+                crate::report::jobs::GEOMETRIC_MISSING,
+            ),
         ],
         &[
             ("turning tool of Ahmadi (2022), hammer-test modes", &turning),
@@ -291,17 +314,3 @@ fn eq34_distribution(
         &folder.path_of("eq34_covariance.json"),
     )?)
 }
-
-/// Depths (mm) from half the lowest to 1.4 times the highest finite limit of `lobes`, 0.025 mm
-/// apart: the credibility contours of every lobe, its top included, lie on the grid.
-fn lobe_covering_depths(lobes: &[LobePoint]) -> Result<Vec<f64>> {
-    let finite = lobes.iter().map(|p| p.depth_mm()).filter(|d| d.is_finite());
-    let (lo, hi) = finite.fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(d), b.max(d)));
-    if !(lo.is_finite() && hi > 0.0) {
-        bail!("no finite limiting depth to cover");
-    }
-    let (from, to, step) = (0.5 * lo, 1.4 * hi, 0.025);
-    let n = ((to - from) / step).ceil() as usize;
-    Ok((0..=n).map(|j| from + step * j as f64).collect())
-}
-

@@ -27,10 +27,10 @@ mod update;
 mod validate;
 
 use bands::BandKind;
-use clap::{Parser, Subcommand};
 use chatter_stability::prepared::Method;
-pub use validate::job_error;
+use clap::{Parser, Subcommand};
 use std::path::PathBuf;
+pub use validate::job_error;
 
 #[derive(Parser)]
 #[command(
@@ -542,32 +542,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             harmonic_force_n,
             feed_per_tooth_mm,
         } => {
-            use chatter_dynamics::limits::{DEPTH_MM, SAMPLE_RATE_HZ, SPEED_RPM};
-            use chatter_dynamics::simulate::{Quantity, SimulationSettings};
-            validate::option("--speed-rpm", speed_rpm, &SPEED_RPM)?;
-            validate::option("--depth-mm", depth_mm, &DEPTH_MM)?;
-            validate::option("--duration-s", duration_s, &validate::DURATION_S)?;
-            validate::option("--sample-rate-hz", sample_rate_hz, &SAMPLE_RATE_HZ)?;
-            validate::option("--random-force-n", random_force_n, &validate::FORCE_N)?;
-            validate::option("--harmonic-force-n", harmonic_force_n, &validate::FORCE_N)?;
-            validate::option("--feed-per-tooth-mm", feed_per_tooth_mm, &validate::FEED_MM)?;
-            validate::simulation_length(duration_s, sample_rate_hz)?;
-            output::check_file("--out", &out)?;
-            let mut s = SimulationSettings::new(
-                speed_rpm,
-                depth_mm * 1e-3,
-                duration_s,
-                sample_rate_hz,
-                seed,
-            );
-            s.quantity = match quantity {
-                QuantityArg::Acceleration => Quantity::Acceleration,
-                QuantityArg::Velocity => Quantity::Velocity,
-                QuantityArg::Displacement => Quantity::Displacement,
+            use chatter_dynamics::simulate::Quantity;
+            let request = chatter_jobs::simulate::SimulateRequest {
+                quantity: match quantity {
+                    QuantityArg::Acceleration => Quantity::Acceleration,
+                    QuantityArg::Velocity => Quantity::Velocity,
+                    QuantityArg::Displacement => Quantity::Displacement,
+                },
+                random_force_n,
+                harmonic_force_n,
+                feed_per_tooth_mm,
+                ..chatter_jobs::simulate::SimulateRequest::new(
+                    speed_rpm,
+                    depth_mm,
+                    duration_s,
+                    sample_rate_hz,
+                    seed,
+                )
             };
-            s.random_force_rms_n = random_force_n;
-            s.harmonic_force_n = harmonic_force_n;
-            s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
+            let s = request.check().map_err(job_error)?;
+            output::check_file("--out", &out)?;
             commands::simulate(&model, &s, &out, quiet)
         }
         Command::Diagnose {

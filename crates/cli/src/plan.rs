@@ -166,7 +166,7 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     validate::option(
         "--feed-per-tooth-mm",
         args.feed_per_tooth_mm,
-        &validate::FEED_MM,
+        &chatter_jobs::simulate::FEED_MM,
     )?;
     let speeds = args.speeds.as_deref().map(validate::speeds).transpose()?;
     let depths = args

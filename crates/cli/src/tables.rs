@@ -4,11 +4,11 @@
 
 use crate::plot::{Markers, Series};
 use chatter_dynamics::Observations;
+use chatter_jobs::bands::MonteCarloBands;
 use chatter_jobs::frf::FrfOutcome;
 use chatter_jobs::lobes::LobeMap;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_uncertainty::geometric::OffsetBoundaries;
-use chatter_jobs::bands::MonteCarloBands;
 use chatter_uncertainty::montecarlo::StabilityMap;
 use chatter_uncertainty::perturbation::{BoundRule, CredibilityPoint};
 use plotters::style::{BLUE, GREEN, RGBColor};

@@ -8,7 +8,7 @@
 //! reuses them for the options that carry the same quantities.
 
 use anyhow::{Result, bail};
-use chatter_dynamics::limits::{Plausible, SPEED_RPM, closed, open_closed, written};
+use chatter_dynamics::limits::{Plausible, SPEED_RPM, open_closed, written};
 use chatter_dynamics::{ModalModel, Observations, Operation};
 use chatter_stability::monodromy::Discretization;
 
@@ -65,12 +65,6 @@ pub fn count(flag: &str, value: usize, min: usize, max: usize, what: &str) -> Re
     }
 }
 
-/// Signal length of `chatter simulate`.
-pub const DURATION_S: Plausible = open_closed(0.0, 3600.0, "a signal length", "s");
-/// Feed per tooth (milling) or per revolution (turning).
-pub const FEED_MM: Plausible = open_closed(0.0, 10.0, "a feed", "mm");
-/// RMS or amplitude of a simulated force (zero allowed).
-pub const FORCE_N: Plausible = closed(0.0, 1e6, "a force", "N");
 /// Width in depth of a cut likelihood (003's sigma, 004's s_S).
 pub const SIGMA_DEPTH_MM: Plausible = open_closed(0.0, 100.0, "a likelihood width", "mm");
 /// Chatter-frequency width of a cut likelihood (004's s_fc).
@@ -84,24 +78,6 @@ pub const PROBABILITY: Plausible = Plausible {
     what: "a probability",
     unit: "",
 };
-
-/// Most output samples of `chatter simulate` (duration times sample rate).
-pub const MAX_SIMULATED_SAMPLES: f64 = 1e8;
-
-/// The simulated signal is at least 2 and at most [`MAX_SIMULATED_SAMPLES`] samples long.
-pub fn simulation_length(duration_s: f64, sample_rate_hz: f64) -> Result<()> {
-    let samples = duration_s * sample_rate_hz;
-    if !(2.0..=MAX_SIMULATED_SAMPLES).contains(&samples) {
-        bail!(
-            "--duration-s {} at --sample-rate-hz {}: {} samples; expected 2 to {} samples",
-            written(duration_s),
-            written(sample_rate_hz),
-            written(samples.floor()),
-            written(MAX_SIMULATED_SAMPLES)
-        );
-    }
-    Ok(())
-}
 
 /// An option given where the chosen kind does not use it.
 pub fn unused(given: bool, flag: &str, context: &str, used_by: &str) -> Result<()> {
@@ -259,10 +235,13 @@ pub fn job_error(e: chatter_jobs::JobError) -> anyhow::Error {
             };
             anyhow::anyhow!(
                 "{source}{}",
-                flags(&text[field.len()..]).replace("where the job offers", "where the command offers")
+                flags(&text[field.len()..])
+                    .replace("where the job offers", "where the command offers")
             )
         }
-        JobError::Refused(_) | JobError::Missing { .. } => anyhow::anyhow!("{}", flags(&e.to_string())),
+        JobError::Refused(_) | JobError::Missing { .. } => {
+            anyhow::anyhow!("{}", flags(&e.to_string()))
+        }
         other => other.into(),
     }
 }

@@ -13,8 +13,8 @@ use chatter_stability::Method;
 use chatter_stability::boundary::{BoundaryOptions, LobePoint};
 use chatter_stability::monodromy::Discretization;
 use chatter_stability::prepared::SolverOptions;
-use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
 use chatter_stability::zero_order::{ZeroOrderOptions, measured_limiting_depths};
+use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
 use chatter_uncertainty::measured::{FrfUncertainty, frf_ensemble, measured_type_b_bands};
 use chatter_uncertainty::montecarlo::{
     FailureKind, QuantileBand, SampledBoundaries, StabilityMap, sample_boundaries,
@@ -66,8 +66,24 @@ pub fn geometric(
     observer: &dyn Observer,
 ) -> Result<GeometricBands> {
     let lobes = lobes(model, method, speeds_rpm, observer)?;
-    let bands = type_b_offsets(&finite_curve(&lobes), offsets)?;
+    let bands = offsets_around(&lobes, offsets)?;
     Ok(GeometricBands { lobes, bands })
+}
+
+/// Type B offsets around the finite points of `lobes`; an error that counts the speeds without
+/// a limit when fewer than two have one.
+fn offsets_around(lobes: &[LobePoint], offsets: TypeBOffsets) -> Result<OffsetBoundaries> {
+    let curve = finite_curve(lobes);
+    if curve.len() < 2 {
+        return Err(JobError::Refused(format!(
+            "{} of {} speeds have no stability limit below the depth ceiling of {} mm; they are \
+             left out of the bands, and the offsets need at least 2 speeds with a limit",
+            crate::lobes::unbounded_count(lobes),
+            lobes.len(),
+            BoundaryOptions::default().max_depth_m * 1e3
+        )));
+    }
+    Ok(type_b_offsets(&curve, offsets)?)
 }
 
 /// The discretization of a band kind that needs one.
@@ -81,20 +97,15 @@ pub fn discretization(method: Method) -> Result<Discretization> {
 
 /// 0 to 1.5 times the deepest finite limit of `reference`, [`DEFAULT_DEPTHS`] depths (mm).
 pub fn default_depths_mm(reference: &[LobePoint]) -> Result<Vec<f64>> {
-    let top = reference
-        .iter()
-        .map(|p| p.depth_mm())
-        .filter(|d| d.is_finite())
-        .fold(0.0, f64::max);
-    if top <= 0.0 {
+    let Some(deepest_m) = chatter_stability::speed_grid::deepest_limit_m(reference) else {
         return Err(JobError::Invalid {
             field: "depths",
             value: "(default)".into(),
             expected: "a depth grid: no finite limiting depth over these speeds".into(),
         });
-    }
+    };
     Ok(chatter_stability::speed_grid::depth_grid(
-        top,
+        deepest_m * 1e3,
         DEFAULT_DEPTHS,
     ))
 }
@@ -325,8 +336,10 @@ impl BandsRequest {
         })
     }
 
-    /// The options the kind uses are in range and those it ignores are absent.
-    fn check_options(&self) -> Result<()> {
+    /// The checks that need no data (linfa's `ParamGuard::check_ref`): the options the kind
+    /// uses are in range and those it ignores are absent. [`Bands::new`] runs them too; a front
+    /// end may run them first, before it reads the model and the distribution.
+    pub fn check(&self) -> Result<()> {
         let context = format!("with `kind` {}", self.kind.name());
         let geometric = self.kind == BandKind::Geometric;
         let montecarlo = self.kind == BandKind::MonteCarlo;
@@ -356,7 +369,12 @@ impl BandsRequest {
                 "`kind` montecarlo and the FRF draws of `gain_sd`/`frequency_sd`",
             )?;
         }
-        checks::unused(self.map && !montecarlo, "map_out", &context, "`kind` montecarlo")?;
+        checks::unused(
+            self.map && !montecarlo,
+            "map_out",
+            &context,
+            "`kind` montecarlo",
+        )?;
         checks::unused(
             self.depths_mm.is_some() && (geometric || (montecarlo && !self.map)),
             "depths",
@@ -460,7 +478,7 @@ impl<'a> Bands<'a> {
         distribution: Option<&'a ParameterDistribution>,
         request: BandsRequest,
     ) -> Result<Self> {
-        request.check_options()?;
+        request.check()?;
         let geometric = request.kind == BandKind::Geometric;
         if !geometric {
             request.rule()?;
@@ -614,7 +632,7 @@ fn measured_geometric(
             r.offset_rpm.unwrap_or(OFFSET_RPM),
             r.offset_mm.unwrap_or(OFFSET_MM),
         )?;
-        let bands = type_b_offsets(&finite_curve(&lobes), offsets)?;
+        let bands = offsets_around(&lobes, offsets)?;
         return Ok(BandsOutcome::Geometric {
             lobes,
             bands,

@@ -137,7 +137,10 @@ mod tests {
         assert!(work_size(&model, d, &[6000.0], "speeds").is_ok());
         let e = work_size(&model, d, &[100.0, 6000.0], "speeds").unwrap_err();
         let text = e.to_string();
-        assert!(text.starts_with("speeds: at 100 rpm one delay needs"), "{text}");
+        assert!(
+            text.starts_with("speeds: at 100 rpm one delay needs"),
+            "{text}"
+        );
         let JobError::TooManySteps {
             steps, lowest_rpm, ..
         } = e

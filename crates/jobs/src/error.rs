@@ -31,6 +31,16 @@ pub enum JobError {
         /// What needs it (`` `kind` perturbation ``).
         needed_by: String,
     },
+    /// A name that is not one of the known ones.
+    #[error("{what} `{value}` is not one of {known:?}")]
+    NotOneOf {
+        /// What is named ("coordinate").
+        what: &'static str,
+        /// The name given.
+        value: String,
+        /// The names known.
+        known: Vec<String>,
+    },
     /// Two fields that exclude each other, or a combination the job cannot do.
     #[error("{0}")]
     Refused(String),

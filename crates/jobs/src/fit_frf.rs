@@ -187,8 +187,7 @@ impl FitFrfOutcome {
         let along = Some(direction.to_string());
         file.modes.retain(|m| {
             m.direction != along
-                && m
-                    .shape
+                && m.shape
                     .as_ref()
                     .is_none_or(|s| s.get(direction).is_none_or(|v| *v == 0.0))
         });

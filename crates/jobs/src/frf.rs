@@ -79,7 +79,11 @@ pub fn frf(model: &ModalModel, request: &FrfRequest) -> Result<FrfOutcome> {
             None => Ok(0),
             Some(n) => op.coordinate_index(n).ok_or_else(|| {
                 let names: Vec<_> = op.coordinates().iter().map(|c| c.name()).collect();
-                JobError::Refused(format!("coordinate `{n}` is not one of {names:?}"))
+                JobError::NotOneOf {
+                    what: "coordinate",
+                    value: n.clone(),
+                    known: names.iter().map(|s| s.to_string()).collect(),
+                }
             }),
         }
     };
@@ -122,7 +126,11 @@ mod tests {
     fn default_range_and_checks() {
         let model = examples::schmitz_2023_milling();
         let out = frf(&model, &FrfRequest::default()).unwrap();
-        let top = model.modes().iter().map(|m| m.frequency_hz()).fold(0.0, f64::max);
+        let top = model
+            .modes()
+            .iter()
+            .map(|m| m.frequency_hz())
+            .fold(0.0, f64::max);
         assert_eq!(out.frequencies_hz.len(), DEFAULT_POINTS);
         assert_eq!(*out.frequencies_hz.last().unwrap(), 2.0 * top);
         let e = frf(

@@ -17,6 +17,7 @@
 //! - [`detect`]: chatter detection of a signal record, as a labelled cut with its evidence.
 //! - [`recordings`]: a shop's recordings to labelled cuts and identified poles, one row per
 //!   record.
+//! - [`simulate`]: a time-domain regenerative cut from checked options.
 //! - [`synthetic`]: the synthetic shop-floor campaign of the proving ground (demo and Python).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
 //! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
@@ -37,6 +38,7 @@ pub mod multiplier;
 pub mod oma;
 pub mod plan;
 pub mod recordings;
+pub mod simulate;
 pub mod synthetic;
 pub mod update;
 

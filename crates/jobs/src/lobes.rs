@@ -184,7 +184,10 @@ impl<'a> Lobes<'a> {
     fn solver(&self, model: &ModalModel) -> Result<Box<dyn PreparedSolver>> {
         let options = BoundaryOptions::default();
         Ok(
-            match (self.request.method.discretization(), self.request.cutting_steps) {
+            match (
+                self.request.method.discretization(),
+                self.request.cutting_steps,
+            ) {
                 (Some(d), Some(m)) => Box::new(PreparedDiscretization::new(
                     d.with_steps(m),
                     model,
@@ -206,9 +209,7 @@ impl<'a> Lobes<'a> {
                 // the depth ceiling of every method
                 &ZeroOrderOptions::default(),
             )?),
-            Dynamics::Modal(model) => Ok(self
-                .solver(model)?
-                .lobes(&self.speeds_rpm, observer)?),
+            Dynamics::Modal(model) => Ok(self.solver(model)?.lobes(&self.speeds_rpm, observer)?),
         }
     }
 
@@ -260,17 +261,12 @@ impl<'a> Lobes<'a> {
 /// The default map depths (m): [`speed_grid::depth_grid`] of the deepest finite limit; an error
 /// when no speed has one.
 pub fn default_map_depths_m(lobes: &[LobePoint]) -> Result<Vec<f64>> {
-    let deepest = lobes
-        .iter()
-        .map(|p| p.depth_m)
-        .filter(|d| d.is_finite())
-        .fold(0.0, f64::max);
-    if deepest <= 0.0 {
-        return Err(JobError::Refused(
+    let deepest = speed_grid::deepest_limit_m(lobes).ok_or_else(|| {
+        JobError::Refused(
             "no speed has a stability limit below the depth ceiling; give `depths` for the map"
                 .into(),
-        ));
-    }
+        )
+    })?;
     Ok(speed_grid::depth_grid(deepest, DEFAULT_MAP_DEPTHS))
 }
 
@@ -320,7 +316,10 @@ mod tests {
         .err()
         .unwrap()
         .to_string();
-        assert!(e.starts_with("cutting_steps is not used with `method` zoa"), "{e}");
+        assert!(
+            e.starts_with("cutting_steps is not used with `method` zoa"),
+            "{e}"
+        );
         let e = Lobes::new(
             &dynamics,
             LobesRequest {

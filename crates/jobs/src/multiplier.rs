@@ -146,9 +146,15 @@ mod tests {
             .unwrap()
             .depth_mm();
         for (factor, stable) in [(0.97, true), (1.03, false)] {
-            let job = Multiplier::new(&model, MultiplierRequest::new(speed, factor * limit)).unwrap();
+            let job =
+                Multiplier::new(&model, MultiplierRequest::new(speed, factor * limit)).unwrap();
             let out = job.run().unwrap();
-            assert_eq!(out.stable, stable, "{factor}: |mu| {}", out.multiplier.modulus());
+            assert_eq!(
+                out.stable,
+                stable,
+                "{factor}: |mu| {}",
+                out.multiplier.modulus()
+            );
             assert!(out.chatter_hz.is_some());
         }
         let zoa = MultiplierRequest {

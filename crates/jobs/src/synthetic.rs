@@ -38,7 +38,9 @@ impl SyntheticCampaignRequest {
 }
 
 /// The nominal model and the campaign's observations.
-pub fn synthetic_campaign(request: &SyntheticCampaignRequest) -> Result<(ModalModel, Observations)> {
+pub fn synthetic_campaign(
+    request: &SyntheticCampaignRequest,
+) -> Result<(ModalModel, Observations)> {
     let nominal = chatter_gap::nominal_milling()?;
     let mut scenario = Scenario::new(HiddenEffect::ParameterError, request.seed);
     if let Some(n) = request.pole_speeds {
@@ -47,12 +49,8 @@ pub fn synthetic_campaign(request: &SyntheticCampaignRequest) -> Result<(ModalMo
     }
     scenario.cuts = request.cuts;
     if let Some(class) = request.effect {
-        (scenario.effect, scenario.error) = effect_at(
-            class,
-            request.magnitude,
-            &nominal,
-            scenario.speed_range_rpm,
-        )?;
+        (scenario.effect, scenario.error) =
+            effect_at(class, request.magnitude, &nominal, scenario.speed_range_rpm)?;
     }
     let observations = chatter_gap::synthesize(&nominal, &scenario)?;
     Ok((nominal, observations))

@@ -100,7 +100,8 @@ impl RecommendOptions {
 
     /// The derating factor 1 - z_{1-P} s of the nominal limit (module docs).
     pub fn derating(&self) -> f64 {
-        (1.0 - chatter_bayes::special::normal_quantile(1.0 - self.risk) * self.limit_relative_sd).max(0.0)
+        (1.0 - chatter_bayes::special::normal_quantile(1.0 - self.risk) * self.limit_relative_sd)
+            .max(0.0)
     }
 }
 

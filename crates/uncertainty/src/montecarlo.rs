@@ -9,12 +9,12 @@
 //! [`SampleFailure`] and reported, never read as stable; one failure does not stop the map.
 
 use crate::error::{Result, UncertaintyError};
+use chatter_bayes::Prior;
+use chatter_bayes::prior::MultivariateNormalPrior;
 pub use chatter_updating::sampled::{
     FailureKind, QuantileBand, SampleFailure, SampledBoundaries, StabilityMap, quantile,
     sample_boundaries,
 };
-use chatter_bayes::Prior;
-use chatter_bayes::prior::MultivariateNormalPrior;
 use nalgebra::DMatrix;
 use rand::SeedableRng;
 

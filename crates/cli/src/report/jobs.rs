@@ -9,11 +9,11 @@ use crate::plot::Series;
 use anyhow::Result;
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_gap::{Diagnosis, EffectClass, Verdict};
+use chatter_jobs::bands::BandCurves;
 use chatter_jobs::diagnose::RecordedDiagnosis;
 use chatter_jobs::recordings::{RecordVerdict, row_file_name};
 use chatter_updating::plan::PlanOutcome;
 use chatter_updating::update::UpdateResult;
-use chatter_jobs::bands::BandCurves;
 
 /// "N cuts, M poles, K signals" of an observations file.
 fn observation_counts(o: &Observations) -> String {
