@@ -9,9 +9,9 @@
 
 use chatter_dynamics::{ModalModel, ModelFile, Observations};
 use chatter_jobs::bands::{BandKind, Bands, BandsOutcome, BandsRequest};
+use chatter_jobs::campaign::{self, Campaign, CampaignOptions};
 use chatter_jobs::lobes::{Dynamics, Lobes, LobesRequest};
 use chatter_jobs::multiplier::{Multiplier, MultiplierRequest};
-use chatter_jobs::campaign::{self, Campaign, CampaignOptions};
 use chatter_stability::Method;
 use chatter_uncertainty::parameters::ParameterDistribution;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -181,7 +181,9 @@ fn method_of(name: &str) -> PyResult<Method> {
 
 /// An optional array as a request field (`None`: the request's default).
 fn vec_of(values: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<Vec<f64>>> {
-    Ok(values.map(|s| s.as_slice().map(<[f64]>::to_vec)).transpose()?)
+    Ok(values
+        .map(|s| s.as_slice().map(<[f64]>::to_vec))
+        .transpose()?)
 }
 
 fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
@@ -295,26 +297,26 @@ fn multiplier<'py>(
     ssv_frequency_ratio: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model_of(model)?;
-    let variation = match (ssv_amplitude_ratio, ssv_frequency_ratio) {
-        (None, None) => None,
-        (Some(a), Some(r)) => Some(
-            chatter_stability::ssv::SpeedVariation::new(a, r)
-                .map_err(|e| value_error(format!("ssv_amplitude_ratio, ssv_frequency_ratio: {e}")))?,
-        ),
-        _ => {
-            return Err(value_error(
-                "ssv_amplitude_ratio and ssv_frequency_ratio go together",
-            ));
-        }
-    };
+    let variation =
+        match (ssv_amplitude_ratio, ssv_frequency_ratio) {
+            (None, None) => None,
+            (Some(a), Some(r)) => Some(chatter_stability::ssv::SpeedVariation::new(a, r).map_err(
+                |e| value_error(format!("ssv_amplitude_ratio, ssv_frequency_ratio: {e}")),
+            )?),
+            _ => {
+                return Err(value_error(
+                    "ssv_amplitude_ratio and ssv_frequency_ratio go together",
+                ));
+            }
+        };
     let request = MultiplierRequest {
         speed_rpm,
         depth_mm,
         method: method_of(method)?,
         variation,
     };
-    let out = run_detached(py, move |_| Multiplier::new(&m, request)?.run())?
-        .map_err(value_error)?;
+    let out =
+        run_detached(py, move |_| Multiplier::new(&m, request)?.run())?.map_err(value_error)?;
     let mu = &out.multiplier;
     let d = PyDict::new(py);
     d.set_item("speed_rpm", speed_rpm)?;
@@ -372,8 +374,7 @@ fn bands_geometric<'py>(
         offset_mm,
         ..BandsRequest::new(BandKind::Geometric)
     };
-    let BandsOutcome::Geometric { bands: b, .. } =
-        run_bands(py, model_of(model)?, None, request)?
+    let BandsOutcome::Geometric { bands: b, .. } = run_bands(py, model_of(model)?, None, request)?
     else {
         return Err(value_error("geometric bands gave another kind"));
     };
@@ -1178,7 +1179,10 @@ fn synthetic_campaign<'py>(
     use chatter_jobs::synthetic::{SyntheticCampaignRequest, synthetic_campaign};
     let effect = match effect {
         "none" => None,
-        name => Some(name.parse::<chatter_gap::EffectClass>().map_err(value_error)?),
+        name => Some(
+            name.parse::<chatter_gap::EffectClass>()
+                .map_err(value_error)?,
+        ),
     };
     let request = SyntheticCampaignRequest {
         cuts,

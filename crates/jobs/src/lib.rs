@@ -4,6 +4,15 @@
 //! same request gives the same numbers bit for bit; they differ only in how they parse and
 //! write.
 //!
+//! Each job has a request struct with the options in user units and their defaults (one home
+//! for the defaults), checked once into the job (linfa's checked parameters, `ParamGuard`):
+//! [`lobes::Lobes::new`], [`bands::Bands::new`], [`multiplier::Multiplier::new`],
+//! [`fit_frf::FitFrfRequest::check`], [`simulate::SimulateRequest::check`],
+//! [`update::PreparedUpdate::new`]. The checks are those of [`checks`]: ranges, the cost guard
+//! [`checks::MAX_STEPS_PER_DELAY`] and the combinations a job refuses. Outcomes are typed
+//! (`LobesOutcome`, `BandsOutcome` with its `curves()`, `MultiplierOutcome`, ...), so summaries
+//! are computed from numbers, never from the text a front end wrote.
+//!
 //! - [`lobes`]: limiting depths per speed (modes or measured FRFs) and the |mu| map.
 //! - [`multiplier`]: the dominant multiplier of one cut and the stability rule |mu| < 1.
 //! - [`fit_frf`]: modes fitted to a measured FRF, merged into a model file.

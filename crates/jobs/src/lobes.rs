@@ -47,7 +47,7 @@ pub fn uses_measured_frf(file: &ModelFile, method: Method, source: &str) -> Resu
         return Err(JobError::Refused(format!(
             "{source}: `method` {} needs modal parameters, and this model gives its dynamics as \
              measured_frf only; use `method` zoa (zero-order lobes straight from the FRF), or \
-             fit modes with `chatter fit-frf` and add them as `modes`",
+             fit modes with `chatter fit-frf` and add them to the model file as its modes",
             method.name()
         )));
     }
