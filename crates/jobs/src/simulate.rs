@@ -129,7 +129,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("`duration_s` 3600 at `sample_rate_hz` 1000000"),
+            e.contains("`duration_s` 3600 at `sample_rate_hz` 1e6"),
             "{e}"
         );
     }
