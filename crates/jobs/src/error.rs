@@ -48,8 +48,8 @@ pub enum JobError {
     /// [`crate::checks::MAX_STEPS_PER_DELAY`] steps per delay at the slowest speed.
     #[error(
         "{field}: at {speed_rpm} rpm one delay needs {steps} steps of the discretization (at \
-         most {max}): give speeds of at least {lowest_rpm} rpm, or use method zoa where the job \
-         offers it",
+         most {max}): give speeds of at least {lowest_rpm} rpm, or use `method` zoa where the \
+         job offers it",
         max = crate::checks::MAX_STEPS_PER_DELAY
     )]
     TooManySteps {
