@@ -8,9 +8,11 @@
 //! and raises `KeyboardInterrupt` once the worker has returned.
 
 use chatter_dynamics::{ModalModel, ModelFile, Observations};
-use chatter_jobs::bands as band_jobs;
+use chatter_jobs::bands::{BandKind, Bands, BandsOutcome, BandsRequest};
 use chatter_jobs::campaign::{self, Campaign, CampaignOptions};
-use chatter_stability::{Method, StabilitySolver};
+use chatter_jobs::lobes::{Dynamics, Lobes, LobesRequest};
+use chatter_jobs::multiplier::{Multiplier, MultiplierRequest};
+use chatter_stability::Method;
 use chatter_uncertainty::parameters::ParameterDistribution;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
@@ -177,22 +179,11 @@ fn method_of(name: &str) -> PyResult<Method> {
     }
 }
 
-fn speeds_of(
-    model: &ModalModel,
-    speeds_rpm: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<Vec<f64>> {
-    match speeds_rpm {
-        Some(s) => {
-            let v = s.as_slice()?.to_vec();
-            if v.is_empty() || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-                return Err(value_error(
-                    "speeds_rpm: expected a non-empty array of speeds > 0 rpm",
-                ));
-            }
-            Ok(v)
-        }
-        None => Ok(chatter_stability::speed_grid::default_speeds_rpm(model)),
-    }
+/// An optional array as a request field (`None`: the request's default).
+fn vec_of(values: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<Vec<f64>>> {
+    Ok(values
+        .map(|s| s.as_slice().map(<[f64]>::to_vec))
+        .transpose()?)
 }
 
 fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
@@ -267,11 +258,14 @@ fn lobes<'py>(
     speeds_rpm: Option<PyReadonlyArray1<'py, f64>>,
     method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = model_of(model)?;
-    let method = method_of(method)?;
-    let speeds = speeds_of(&m, speeds_rpm)?;
+    let dynamics = Dynamics::Modal(model_of(model)?);
+    let request = LobesRequest {
+        method: method_of(method)?,
+        speeds_rpm: vec_of(speeds_rpm)?,
+        ..LobesRequest::default()
+    };
     let points = run_detached(py, move |observer| {
-        band_jobs::lobes(&m, method, &speeds, observer)
+        Lobes::new(&dynamics, request)?.lobes(observer)
     })?
     .map_err(value_error)?;
     let d = PyDict::new(py);
@@ -292,59 +286,98 @@ fn lobes<'py>(
 
 /// The dominant Floquet multiplier at one cut (the `chatter multiplier` numbers).
 #[pyfunction]
-#[pyo3(signature = (model, speed_rpm, depth_mm, method="fdm"))]
+#[pyo3(signature = (model, speed_rpm, depth_mm, method="fdm", ssv_amplitude_ratio=None, ssv_frequency_ratio=None))]
 fn multiplier<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     speed_rpm: f64,
     depth_mm: f64,
     method: &str,
+    ssv_amplitude_ratio: Option<f64>,
+    ssv_frequency_ratio: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model_of(model)?;
-    let Some(solver) = method_of(method)?.discretization() else {
-        return Err(value_error(
-            "method \"zoa\" gives limiting depths, not multipliers; use \"fdm\" or \"sdm\"",
-        ));
+    let variation =
+        match (ssv_amplitude_ratio, ssv_frequency_ratio) {
+            (None, None) => None,
+            (Some(a), Some(r)) => Some(chatter_stability::ssv::SpeedVariation::new(a, r).map_err(
+                |e| value_error(format!("ssv_amplitude_ratio, ssv_frequency_ratio: {e}")),
+            )?),
+            _ => {
+                return Err(value_error(
+                    "ssv_amplitude_ratio and ssv_frequency_ratio go together",
+                ));
+            }
+        };
+    let request = MultiplierRequest {
+        speed_rpm,
+        depth_mm,
+        method: method_of(method)?,
+        variation,
     };
-    let (mu, chatter_hz) = run_detached(py, move |_| {
-        solver.chatter_frequency_hz(&m, speed_rpm, depth_mm * 1e-3)
-    })?
-    .map_err(value_error)?;
+    let out =
+        run_detached(py, move |_| Multiplier::new(&m, request)?.run())?.map_err(value_error)?;
+    let mu = &out.multiplier;
     let d = PyDict::new(py);
     d.set_item("speed_rpm", speed_rpm)?;
     d.set_item("depth_mm", depth_mm)?;
+    d.set_item("method", out.method)?;
     d.set_item("modulus", mu.modulus())?;
     d.set_item("real", mu.value.re)?;
     d.set_item("imag", mu.value.im)?;
-    d.set_item("frequency_hz", mu.principal_frequency_hz())?;
-    d.set_item("chatter_hz", chatter_hz)?;
-    d.set_item("kind", to_py(py, &mu.kind())?)?;
-    d.set_item("stable", mu.modulus() < 1.0)?;
+    match (variation, out.chatter_hz) {
+        (Some(v), _) => {
+            d.set_item("ssv_amplitude_ratio", v.amplitude_ratio())?;
+            d.set_item("ssv_frequency_ratio", v.frequency_ratio())?;
+            d.set_item("period_s", mu.period_s)?;
+        }
+        (None, chatter_hz) => {
+            d.set_item("frequency_hz", mu.principal_frequency_hz())?;
+            d.set_item("chatter_hz", chatter_hz)?;
+            d.set_item("kind", to_py(py, &mu.kind())?)?;
+        }
+    }
+    d.set_item("stable", out.stable)?;
     Ok(d)
+}
+
+/// A band job's outcome on a modal model, checked and run on a worker thread.
+fn run_bands(
+    py: Python<'_>,
+    model: ModalModel,
+    distribution: Option<ParameterDistribution>,
+    request: BandsRequest,
+) -> PyResult<BandsOutcome> {
+    let dynamics = Dynamics::Modal(model);
+    run_detached(py, move |observer| {
+        Bands::new(&dynamics, distribution.as_ref(), request)?.run(observer)
+    })?
+    .map_err(value_error)
 }
 
 /// Type B offset boundaries (001) around the lobes of `method` (the `chatter bands --kind
 /// geometric` numbers; NaN where an offset curve does not cover a speed).
 #[pyfunction]
-#[pyo3(signature = (model, speeds_rpm=None, offset_rpm=100.0, offset_mm=0.2, method="zoa"))]
+#[pyo3(signature = (model, speeds_rpm=None, offset_rpm=None, offset_mm=None, method="zoa"))]
 fn bands_geometric<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     speeds_rpm: Option<PyReadonlyArray1<'py, f64>>,
-    offset_rpm: f64,
-    offset_mm: f64,
+    offset_rpm: Option<f64>,
+    offset_mm: Option<f64>,
     method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = model_of(model)?;
-    let method = method_of(method)?;
-    let speeds = speeds_of(&m, speeds_rpm)?;
-    let offsets = chatter_uncertainty::geometric::TypeBOffsets::new(offset_rpm, offset_mm)
-        .map_err(value_error)?;
-    let g = run_detached(py, move |observer| {
-        band_jobs::geometric(&m, method, &speeds, offsets, observer)
-    })?
-    .map_err(value_error)?;
-    let b = &g.bands;
+    let request = BandsRequest {
+        method: Some(method_of(method)?),
+        speeds_rpm: vec_of(speeds_rpm)?,
+        offset_rpm,
+        offset_mm,
+        ..BandsRequest::new(BandKind::Geometric)
+    };
+    let BandsOutcome::Geometric { bands: b, .. } = run_bands(py, model_of(model)?, None, request)?
+    else {
+        return Err(value_error("geometric bands gave another kind"));
+    };
     let depth_at = chatter_uncertainty::geometric::OffsetBoundaries::depth_at;
     let d = PyDict::new(py);
     d.set_item(
@@ -439,22 +472,19 @@ fn bands_perturbation<'py>(
     method: &str,
     coverage: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use chatter_uncertainty::perturbation::BoundRule;
-    let m = model_of(model)?;
-    let dist = distribution_of(distribution)?;
-    let method = method_of(method)?;
-    let speeds = speeds_of(&m, speeds_rpm)?;
-    let depths = depths_mm
-        .map(|d| d.as_slice().map(<[f64]>::to_vec))
-        .transpose()?;
-    let rule = match coverage {
-        Some(c) => BoundRule::coverage(c).map_err(|e| value_error(format!("coverage: {e}")))?,
-        None => BoundRule::ComplexSd,
+    let request = BandsRequest {
+        method: Some(method_of(method)?),
+        speeds_rpm: vec_of(speeds_rpm)?,
+        depths_mm: vec_of(depths_mm)?,
+        coverage,
+        ..BandsRequest::new(BandKind::Perturbation)
     };
-    let p = run_detached(py, move |observer| {
-        band_jobs::perturbation(&m, &dist, method, rule, &speeds, depths, observer)
-    })?
-    .map_err(value_error)?;
+    let dist = distribution_of(distribution)?;
+    let BandsOutcome::Perturbation { bands: p, .. } =
+        run_bands(py, model_of(model)?, Some(dist), request)?
+    else {
+        return Err(value_error("perturbation bands gave another kind"));
+    };
     let d = PyDict::new(py);
     d.set_item(
         "speed_rpm",
@@ -480,33 +510,35 @@ fn bands_perturbation<'py>(
 /// and chatter-frequency quantiles per speed, the per-draw limits and the probability-of-
 /// stability map on `map_depths_mm` (default 0 to 1.5 times the deepest 95 % quantile).
 #[pyfunction]
-#[pyo3(signature = (model, distribution, speeds_rpm=None, samples=500, seed=0, method="fdm", map_depths_mm=None))]
+#[pyo3(signature = (model, distribution, speeds_rpm=None, samples=None, seed=None, method="fdm", map_depths_mm=None))]
 #[allow(clippy::too_many_arguments)]
 fn bands_montecarlo<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
     distribution: &Bound<'py, PyAny>,
     speeds_rpm: Option<PyReadonlyArray1<'py, f64>>,
-    samples: usize,
-    seed: u64,
+    samples: Option<usize>,
+    seed: Option<u64>,
     method: &str,
     map_depths_mm: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = model_of(model)?;
+    let request = BandsRequest {
+        method: Some(method_of(method)?),
+        speeds_rpm: vec_of(speeds_rpm)?,
+        depths_mm: vec_of(map_depths_mm)?,
+        samples,
+        seed,
+        map: true,
+        ..BandsRequest::new(BandKind::MonteCarlo)
+    };
     let dist = distribution_of(distribution)?;
-    let method = method_of(method)?;
-    let speeds = speeds_of(&m, speeds_rpm)?;
-    chatter_jobs::error::count("samples", samples, 2, 100_000, "Monte Carlo samples")
-        .map_err(value_error)?;
-    let depths = map_depths_mm
-        .map(|d| d.as_slice().map(<[f64]>::to_vec))
-        .transpose()?;
-    let (mc, map) = run_detached(py, move |observer| {
-        let mc = band_jobs::montecarlo(&m, &dist, method, samples, seed, &speeds, observer)?;
-        let map = mc.map(depths)?;
-        Ok::<_, chatter_jobs::JobError>((mc, map))
-    })?
-    .map_err(value_error)?;
+    let BandsOutcome::MonteCarlo {
+        bands: mc,
+        map: Some(map),
+    } = run_bands(py, model_of(model)?, Some(dist), request)?
+    else {
+        return Err(value_error("Monte Carlo bands gave no map"));
+    };
     let d = PyDict::new(py);
     d.set_item(
         "speed_rpm",
@@ -564,25 +596,28 @@ fn simulate<'py>(
     harmonic_force_n: f64,
     feed_per_tooth_mm: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use chatter_dynamics::simulate::{Quantity, SimulationSettings};
+    use chatter_dynamics::simulate::Quantity;
+    use chatter_jobs::simulate::SimulateRequest;
     let m = model_of(model)?;
-    let mut s =
-        SimulationSettings::new(speed_rpm, depth_mm * 1e-3, duration_s, sample_rate_hz, seed);
-    s.quantity = match quantity {
-        "acceleration" => Quantity::Acceleration,
-        "velocity" => Quantity::Velocity,
-        "displacement" => Quantity::Displacement,
-        other => {
-            return Err(value_error(format!(
-                "quantity {other:?}: expected \"acceleration\", \"velocity\" or \"displacement\""
-            )));
-        }
+    let request = SimulateRequest {
+        quantity: match quantity {
+            "acceleration" => Quantity::Acceleration,
+            "velocity" => Quantity::Velocity,
+            "displacement" => Quantity::Displacement,
+            other => {
+                return Err(value_error(format!(
+                    "quantity {other:?}: expected \"acceleration\", \"velocity\" or \"displacement\""
+                )));
+            }
+        },
+        random_force_n,
+        harmonic_force_n,
+        feed_per_tooth_mm,
+        ..SimulateRequest::new(speed_rpm, depth_mm, duration_s, sample_rate_hz, seed)
     };
-    s.random_force_rms_n = random_force_n;
-    s.harmonic_force_n = harmonic_force_n;
-    s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
+    let s = request.check().map_err(value_error)?;
     let sim = run_detached(py, move |observer| {
-        chatter_dynamics::simulate::simulate_with_observer(&m, &s, observer)
+        chatter_jobs::simulate::simulate(&m, &s, observer)
     })?
     .map_err(value_error)?;
     let names: Vec<String> = sim.channels.iter().map(|c| c.name.clone()).collect();
@@ -618,16 +653,21 @@ fn detect<'py>(
     names: Option<Vec<String>>,
     once_per_rev_channel: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use chatter_oma::detection::{DetectionOptions, Verdict};
+    use chatter_jobs::detect::{DetectRequest, detect_signals, is_stable};
     let signals = signals_of(data, sample_rate_hz, names)?;
-    let mut options = DetectionOptions::new(speed_rpm / 60.0);
-    options.once_per_rev_channel = once_per_rev_channel;
     let det = run_detached(py, move |observer| {
-        chatter_oma::detection::detect_with_observer(&signals, &options, observer)
+        detect_signals(
+            &signals,
+            speed_rpm,
+            once_per_rev_channel,
+            None,
+            &DetectRequest::default(),
+            observer,
+        )
     })?
     .map_err(value_error)?;
     let d = PyDict::new(py);
-    d.set_item("stable", det.verdict == Verdict::Stable)?;
+    d.set_item("stable", is_stable(&det))?;
     d.set_item("chatter_hz", det.chatter_hz)?;
     d.set_item("evidence", to_py(py, &det.evidence)?)?;
     Ok(d)
@@ -936,12 +976,8 @@ fn plan<'py>(
     request.method = optional_method(method)?;
     request.target = target.map(|t| t.parse().map_err(value_error)).transpose()?;
     request.paths = paths;
-    request.speeds_rpm = speeds_rpm
-        .map(|s| s.as_slice().map(<[f64]>::to_vec))
-        .transpose()?;
-    request.depths_mm = depths_mm
-        .map(|s| s.as_slice().map(<[f64]>::to_vec))
-        .transpose()?;
+    request.speeds_rpm = vec_of(speeds_rpm)?;
+    request.depths_mm = vec_of(depths_mm)?;
     request.feed_per_tooth_mm = feed_per_tooth_mm;
     request.seed = seed;
     request.max_tests = max_tests;
@@ -1124,33 +1160,36 @@ fn campaign_table(lines: &Bound<'_, PyList>) -> PyResult<String> {
     Ok(campaign::table(&lines))
 }
 
-/// A synthetic shop-floor campaign of the gap diagnosis's proving ground
-/// (`chatter_gap::synthesize` on `chatter_gap::nominal_milling`): the nominal model and
-/// observations of a machine with `effect` (an effect class name, or "none") at `magnitude`
-/// (1 = the reference size of the class), `cuts` test cuts and poles at `pole_speeds` speeds
-/// (0: none), seeded. Returns `(model, observations)` as dicts.
+/// A synthetic shop-floor campaign of the gap diagnosis's proving ground (the recipe of
+/// `chatter_jobs::synthetic`, the one `chatter demo` uses): the nominal model and observations
+/// of a machine with `effect` (an effect class name, or "none") at `magnitude` (1 = the
+/// reference size of the class), `cuts` test cuts and poles at `pole_speeds` speeds spread over
+/// the range (0: none; None: the default 3000, 6000, 9000 and 12 000 rpm), seeded. Returns
+/// `(model, observations)` as dicts.
 #[pyfunction]
-#[pyo3(signature = (effect, magnitude, seed, cuts=32, pole_speeds=4))]
+#[pyo3(signature = (effect, magnitude, seed, cuts=32, pole_speeds=None))]
 fn synthetic_campaign<'py>(
     py: Python<'py>,
     effect: &str,
     magnitude: f64,
     seed: u64,
     cuts: usize,
-    pole_speeds: usize,
+    pole_speeds: Option<usize>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let nominal = chatter_gap::nominal_milling().map_err(value_error)?;
-    let mut scenario = chatter_gap::Scenario::new(chatter_gap::HiddenEffect::ParameterError, seed);
-    let (lo, hi) = scenario.speed_range_rpm;
-    scenario = scenario.with_speed_range(lo, hi, pole_speeds);
-    scenario.cuts = cuts;
-    if effect != "none" {
-        let class: chatter_gap::EffectClass = effect.parse().map_err(value_error)?;
-        (scenario.effect, scenario.error) =
-            chatter_gap::generator::effect_at(class, magnitude, &nominal, scenario.speed_range_rpm)
-                .map_err(value_error)?;
-    }
-    let observations = chatter_gap::synthesize(&nominal, &scenario).map_err(value_error)?;
+    use chatter_jobs::synthetic::{SyntheticCampaignRequest, synthetic_campaign};
+    let effect = match effect {
+        "none" => None,
+        name => Some(
+            name.parse::<chatter_gap::EffectClass>()
+                .map_err(value_error)?,
+        ),
+    };
+    let request = SyntheticCampaignRequest {
+        cuts,
+        pole_speeds,
+        ..SyntheticCampaignRequest::new(effect, magnitude, seed)
+    };
+    let (nominal, observations) = synthetic_campaign(&request).map_err(value_error)?;
     Ok((
         to_py(py, &ModelFile::from_model(&nominal))?,
         from_json(py, &observations.to_json_string())?,

@@ -52,6 +52,20 @@ pub fn weighted_quantile(mut values: Vec<(f64, f64)>, q: f64) -> f64 {
     values.last().map_or(f64::NAN, |x| x.0)
 }
 
+/// The `q` quantile of the finite `values`, linearly interpolated between order statistics
+/// (Hyndman & Fan type 7, R's default); NaN when there are none. The unweighted companion of
+/// [`weighted_quantile`], both the one home of empirical quantiles.
+pub fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
+    values.retain(|v| v.is_finite());
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let h = (values.len() - 1) as f64 * q.clamp(0.0, 1.0);
+    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+    values[lo] + (h - lo as f64) * (values[hi] - values[lo])
+}
+
 /// The standard normal distribution function Phi(x) = erfc(-x / sqrt 2) / 2 (relative error
 /// < 1.2e-7, from [`erfc`]).
 pub fn normal_cdf(x: f64) -> f64 {

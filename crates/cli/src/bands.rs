@@ -1,21 +1,24 @@
-//! `chatter bands`: geometric Type B offsets, perturbation credibility bounds and Monte Carlo
-//! probability-of-stability maps around the lobes.
+//! `chatter bands`: the options as a `chatter_jobs::bands::BandsRequest` (geometric Type B
+//! offsets, perturbation credibility bounds, Monte Carlo probability-of-stability maps; on a
+//! model with `measured_frf`, geometric bands straight from the FRFs), the outcome as CSV, SVG
+//! and the report page.
 
-use crate::commands::{Method, compute_lobes, markers};
 use crate::output::{self, emit, write_atomic};
 use crate::plot::{Series, line_chart_svg};
+use crate::progress::Bar;
 use crate::report::jobs;
-use crate::validate;
-use crate::{inputs, progress::Bar};
-use anyhow::{Result, bail};
+use crate::tables::{self, band_series, markers};
+use crate::{inputs, validate};
+use anyhow::{Result, anyhow, bail};
 use chatter_dynamics::{ModalModel, Observations};
-use chatter_jobs::bands as band_jobs;
-use chatter_uncertainty::geometric::{OffsetBoundaries, TypeBOffsets, type_b_offsets};
-use chatter_uncertainty::montecarlo::FailureKind;
+use chatter_jobs::JobError;
+use chatter_jobs::bands::{self as band_jobs, Bands, BandsOutcome, BandsRequest};
+use chatter_jobs::lobes::Dynamics;
+use chatter_stability::prepared::Method;
+use chatter_uncertainty::geometric::OffsetBoundaries;
 use chatter_uncertainty::parameters::ParameterDistribution;
 use chatter_uncertainty::perturbation::BoundRule;
 use plotters::style::{BLUE, GREEN, RGBColor};
-use std::fmt::Write as _;
 use std::path::Path;
 
 /// Band kinds.
@@ -72,15 +75,6 @@ pub struct BandRequest<'a> {
     pub quiet: bool,
 }
 
-/// Default Type B speed offset (seed 001).
-pub(crate) const OFFSET_RPM: f64 = 100.0;
-/// Default Type B depth offset (seed 001).
-pub(crate) const OFFSET_MM: f64 = 0.2;
-/// Default Monte Carlo samples.
-const SAMPLES: usize = 500;
-/// Most Monte Carlo samples.
-const MAX_SAMPLES: usize = 100_000;
-
 /// The kind's name as the user types it.
 fn kind_name(kind: BandKind) -> String {
     use clap::ValueEnum;
@@ -88,182 +82,264 @@ fn kind_name(kind: BandKind) -> String {
         .map_or_else(String::new, |v| v.get_name().to_string())
 }
 
-/// Options the kind uses are in range and options it ignores are absent; outputs writable.
-fn check_options(req: &BandRequest) -> Result<()> {
+/// The options that concern files and outputs (what the job never sees): the distribution's
+/// files only for the kinds that use one, the observations only with a plot or a report, the
+/// outputs writable.
+fn check_outputs(req: &BandRequest) -> Result<()> {
     let context = format!("with --kind {}", kind_name(req.kind));
-    let geometric = req.kind == BandKind::Geometric;
-    let montecarlo = req.kind == BandKind::Montecarlo;
-    for (given, flag, used_by) in [
-        (req.offsets.0.is_some(), "--offset-rpm", "--kind geometric"),
-        (req.offsets.1.is_some(), "--offset-mm", "--kind geometric"),
-    ] {
-        validate::unused(given && !geometric, flag, &context, used_by)?;
-    }
     for (given, flag) in [
         (req.posterior.is_some(), "--posterior"),
         (req.covariance.is_some(), "--covariance"),
     ] {
         validate::unused(
-            given && geometric,
+            given && req.kind == BandKind::Geometric,
             flag,
             &context,
             "--kind perturbation and montecarlo",
         )?;
     }
-    let frf_draws = crate::measured_bands::frf_uncertainty(req).is_some();
-    for (given, flag) in [
-        (req.frf_sd.0.is_some(), "--gain-sd"),
-        (req.frf_sd.1.is_some(), "--frequency-sd"),
-    ] {
-        validate::unused(given && !geometric, flag, &context, "--kind geometric")?;
-    }
-    if frf_draws && (req.offsets.0.is_some() || req.offsets.1.is_some()) {
-        bail!(
-            "--offset-rpm/--offset-mm and --gain-sd/--frequency-sd both given: the offsets are \
-             either stated or set by the FRF uncertainty; give one of the two"
-        );
-    }
-    for (given, flag) in [
-        (req.samples.is_some(), "--samples"),
-        (req.seed.is_some(), "--seed"),
-    ] {
-        validate::unused(
-            given && !montecarlo && !frf_draws,
-            flag,
-            &context,
-            "--kind montecarlo and the FRF draws of --gain-sd/--frequency-sd",
-        )?;
-    }
-    validate::unused(
-        req.map_out.is_some() && !montecarlo,
-        "--map-out",
-        &context,
-        "--kind montecarlo",
-    )?;
-    validate::unused(
-        req.depths.is_some() && (geometric || (montecarlo && req.map_out.is_none())),
-        "--depths",
-        &if montecarlo {
-            format!("{context} without --map-out")
-        } else {
-            context.clone()
-        },
-        "the perturbation grid and the Monte Carlo map (--map-out)",
-    )?;
     validate::unused(
         req.observations.is_some() && req.plot.is_none() && req.report.is_none(),
         "--observations",
         "without --plot or --report",
         "drawing the observed cuts on the plot",
     )?;
-    if let Some(v) = req.offsets.0 {
-        validate::option("--offset-rpm", v, &validate::OFFSET_RPM)?;
-    }
-    if let Some(v) = req.offsets.1 {
-        validate::option("--offset-mm", v, &validate::OFFSET_MM)?;
-    }
-    if let Some(n) = req.samples {
-        validate::count("--samples", n, 2, MAX_SAMPLES, "Monte Carlo samples")?;
-    }
-    if let Some(spec) = req.depths {
-        validate::grid("--depths", spec, &validate::DEPTH_GRID_MM)?;
-    }
     output::check_optional_file("--out", req.out)?;
     output::check_optional_file("--map-out", req.map_out)?;
     output::check_optional_file("--plot", req.plot)?;
     output::check_optional_file("--report", req.report)
 }
 
-/// `chatter bands`.
-pub fn bands(req: &BandRequest) -> Result<()> {
-    check_options(req)?;
-    let measured = chatter_frf::read_model_file(req.model)
-        .map(|f| f.measured_frf.is_some())
-        .unwrap_or(false);
-    if measured && req.kind == BandKind::Geometric && matches!(req.method, None | Some(Method::Zoa))
-    {
-        crate::measured_bands::check(req)?;
-        return crate::measured_bands::bands(req, req.model);
-    }
-    if crate::measured_bands::frf_uncertainty(req).is_some() {
-        bail!(
-            "--gain-sd/--frequency-sd: {} has no measured_frf; the FRF uncertainty applies to \
-             zero-order geometric bands of a model with measured_frf",
-            req.model.display()
-        );
-    }
-    let speeds = req.speeds.map(validate::speeds).transpose()?;
-    let model = inputs::model(req.model)?;
-    let obs = req.observations.map(inputs::observations).transpose()?;
-    let speeds = match speeds {
-        Some(s) => s,
-        None => chatter_stability::speed_grid::lobe_speeds_rpm(&model),
-    };
-    if let Some(offset) = req.offsets.0 {
-        let span = speeds.last().unwrap_or(&0.0) - speeds.first().unwrap_or(&0.0);
-        if offset > span {
-            bail!(
-                "--offset-rpm {}: larger than the speed range ({} rpm); expected an offset \
-                 within the speeds of the lobes",
-                validate::as_typed("--offset-rpm", offset),
-                chatter_dynamics::limits::written(span)
-            );
-        }
-    }
-    if let Some(d) = req.method.unwrap_or(Method::Fdm).discretization()
-        && (req.kind != BandKind::Geometric || req.method.is_some())
-    {
-        validate::work_size(&model, d, &speeds, "--speeds")?;
-    }
-    match req.kind {
-        BandKind::Geometric => geometric(req, &model, &speeds, obs.as_ref()),
-        BandKind::Perturbation => perturbation(req, &model, &speeds, obs.as_ref()),
-        BandKind::Montecarlo => montecarlo(req, &model, &speeds, obs.as_ref()),
-    }
+/// The job's request from the options.
+fn request(req: &BandRequest) -> Result<BandsRequest> {
+    Ok(BandsRequest {
+        kind: match req.kind {
+            BandKind::Geometric => band_jobs::BandKind::Geometric,
+            BandKind::Perturbation => band_jobs::BandKind::Perturbation,
+            BandKind::Montecarlo => band_jobs::BandKind::MonteCarlo,
+        },
+        method: req.method,
+        speeds_rpm: req.speeds.map(validate::speeds).transpose()?,
+        depths_mm: req
+            .depths
+            .map(|spec| validate::grid("--depths", spec, &chatter_jobs::checks::DEPTH_GRID_MM))
+            .transpose()?,
+        offset_rpm: req.offsets.0,
+        offset_mm: req.offsets.1,
+        gain_sd: req.frf_sd.0,
+        frequency_sd: req.frf_sd.1,
+        samples: req.samples,
+        seed: req.seed,
+        coverage: req.coverage,
+        map: req.map_out.is_some(),
+    })
 }
 
-fn geometric(
+/// `chatter bands`.
+pub fn bands(req: &BandRequest) -> Result<()> {
+    check_outputs(req)?;
+    let request = request(req)?;
+    // the options before the files: a misplaced option is named even when a file is the wrong kind
+    request.check().map_err(crate::job_error)?;
+    let dynamics = inputs::dynamics(req.model, request.method())?;
+    let model = match &dynamics {
+        Dynamics::Modal(m) => Some(m),
+        Dynamics::Measured(_) => {
+            if req.report.is_some() || req.observations.is_some() {
+                bail!(
+                    "--report and --observations are not available for a model with \
+                     measured_frf; use --out and --plot"
+                );
+            }
+            None
+        }
+    };
+    let distribution = match model {
+        Some(m) if req.kind != BandKind::Geometric => distribution(req, m)?,
+        _ => None,
+    };
+    let job = Bands::new(&dynamics, distribution.as_ref(), request).map_err(|e| match e {
+        JobError::Missing { .. } => anyhow!(
+            "--kind {} needs a parameter distribution: --posterior DIR (from `chatter update`) \
+             or --covariance FILE ({{\"parameter_names\": [...], \"covariance\": [[...]]}})",
+            kind_name(req.kind)
+        ),
+        e => crate::job_error(e),
+    })?;
+    let obs = req.observations.map(inputs::observations).transpose()?;
+    let speeds = job.speeds_rpm().len();
+    let bar = match req.kind {
+        BandKind::Geometric => {
+            let method = job.request().method();
+            // zero-order lobes are instant, and the FRF ensemble reports nothing: no bar
+            let bar = Bar::new(
+                speeds as u64,
+                "lobes",
+                req.quiet || method == Method::Zoa || model.is_none(),
+            );
+            bar.announce(&format!("{speeds} speeds, {}", method.name()));
+            bar
+        }
+        BandKind::Perturbation => Bar::new(speeds as u64, "credibility grid", req.quiet),
+        BandKind::Montecarlo => Bar::new(job.samples() as u64, "Monte Carlo samples", req.quiet),
+    };
+    let outcome = job.run(&bar).map_err(crate::job_error)?;
+    bar.finish();
+    let Some(model) = model else {
+        return measured(req, &outcome);
+    };
+    write(req, model, obs.as_ref(), &outcome)
+}
+
+/// The outputs of bands on a modal model.
+fn write(
     req: &BandRequest,
     model: &ModalModel,
-    speeds: &[f64],
     obs: Option<&Observations>,
+    outcome: &BandsOutcome,
 ) -> Result<()> {
-    let lobes = compute_lobes(model, req.method.unwrap_or(Method::Zoa), speeds, req.quiet)?;
-    crate::commands::warn_unbounded(&lobes, "they are left out of the bands");
-    let curve = band_jobs::finite_curve(&lobes);
-    let offsets = TypeBOffsets::new(
-        req.offsets.0.unwrap_or(OFFSET_RPM),
-        req.offsets.1.unwrap_or(OFFSET_MM),
-    )?;
-    let bands = type_b_offsets(&curve, offsets)?;
-    let csv = geometric_csv(&bands);
+    let mut warnings = Vec::new();
+    let (csv, title, series, extra, lower_label, why_missing) = match outcome {
+        BandsOutcome::Geometric { lobes, bands, .. } => {
+            tables::warn_unbounded(lobes, "they are left out of the bands");
+            let series = band_series(
+                band_jobs::finite_curve(lobes),
+                bands.lower.clone(),
+                bands.upper.clone(),
+                ["mean boundary", "lower offset", "upper offset"],
+            );
+            let stem = req
+                .plot
+                .and_then(Path::file_stem)
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "bands".into());
+            let extra = if req.plot.is_some() || req.report.is_some() {
+                offset_detail_svgs(&stem, bands)?.to_vec()
+            } else {
+                Vec::new()
+            };
+            (
+                tables::geometric_csv(bands),
+                "Type B offset boundaries".to_string(),
+                series,
+                extra,
+                "lower offset boundary",
+                jobs::GEOMETRIC_MISSING,
+            )
+        }
+        BandsOutcome::Perturbation { rule, bands } => {
+            let (csv, series) = tables::credibility_bands(&bands.bounds, *rule);
+            (
+                csv,
+                format!(
+                    "Credibility bounds at the posterior mean: {}",
+                    rule_title(*rule)
+                ),
+                series,
+                Vec::new(),
+                "lower credibility bound",
+                jobs::PERTURBATION_MISSING,
+            )
+        }
+        BandsOutcome::MonteCarlo { bands, map } => {
+            if let Some(warning) = band_jobs::failure_warning(bands) {
+                eprintln!("warning: {warning}");
+                warnings.push(warning);
+            }
+            if let (Some(path), Some(map)) = (req.map_out, map) {
+                write_atomic(path, tables::stability_map_csv(map).as_bytes())?;
+            }
+            let curve = |f: fn(&chatter_uncertainty::montecarlo::QuantileBand) -> f64| {
+                bands
+                    .depth
+                    .iter()
+                    .map(|d| (d.speed_rpm, f(d)))
+                    .filter(|p| p.1.is_finite())
+                    .collect::<Vec<_>>()
+            };
+            let series = band_series(
+                curve(|d| d.q50),
+                curve(|d| d.q05),
+                curve(|d| d.q95),
+                ["P_s = 0.5", "P_s = 0.95", "P_s = 0.05"],
+            );
+            (
+                tables::montecarlo_csv(bands),
+                "Monte Carlo probability of stability".to_string(),
+                series,
+                Vec::new(),
+                "P_s = 0.95 contour",
+                jobs::MONTECARLO_MISSING,
+            )
+        }
+    };
     emit(req.out, &csv)?;
     if req.plot.is_none() && req.report.is_none() {
         return Ok(());
     }
-    let series = band_series(
-        curve,
-        bands.lower.clone(),
-        bands.upper.clone(),
-        ["mean boundary", "lower offset", "upper offset"],
-    );
-    let title = "Type B offset boundaries";
-    let svg = band_plot(title, &series, obs)?;
-    let stem = req
-        .plot
-        .and_then(Path::file_stem)
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "bands".into());
-    let extra = offset_detail_svgs(&stem, &bands)?;
+    let svg = band_plot(&title, &series, obs)?;
     if let Some(path) = req.plot {
+        write_atomic(path, svg.as_bytes())?;
         for (name, svg) in &extra {
             write_atomic(&path.with_file_name(name), svg.as_bytes())?;
         }
     }
-    let mut figures = vec![(title.to_string(), svg)];
-    figures.extend(extra);
-    let label = ("lower offset boundary", jobs::GEOMETRIC_MISSING);
-    finish(req, model, obs, &csv, label, figures, Vec::new())
+    if let Some(path) = req.report {
+        let mut figures = vec![(title, svg)];
+        figures.extend(extra);
+        jobs::bands(&jobs::BandsResult {
+            kind: &kind_name(req.kind),
+            lower_label,
+            why_missing,
+            model,
+            observations: obs,
+            curves: &outcome.curves(),
+            csv: &csv,
+            figures,
+            warnings,
+        })?
+        .write(path)?;
+    }
+    Ok(())
+}
+
+/// The outputs of geometric bands on measured FRFs (CSV and plot).
+fn measured(req: &BandRequest, outcome: &BandsOutcome) -> Result<()> {
+    let BandsOutcome::Geometric { lobes, bands, frf } = outcome else {
+        bail!("bands on measured FRFs are geometric");
+    };
+    if let Some(f) = frf {
+        eprintln!(
+            "offsets from the FRF uncertainty (gain sd {}, frequency sd {}, {} draws, k = {}): \
+             {:.1} rpm, {:.4} mm around the pocket at {:.0} rpm, {:.4} mm",
+            f.gain_sd,
+            f.frequency_sd,
+            f.draws,
+            f.coverage_factor,
+            f.offsets.offset_rpm(),
+            f.offsets.offset_mm(),
+            f.pocket.0,
+            f.pocket.1
+        );
+    }
+    emit(req.out, &tables::geometric_csv(bands))?;
+    if let Some(path) = req.plot {
+        let series = band_series(
+            band_jobs::finite_curve(lobes),
+            bands.lower.clone(),
+            bands.upper.clone(),
+            ["lobes from the FRF", "lower offset", "upper offset"],
+        );
+        let svg = line_chart_svg(
+            "Type B offset boundaries on measured FRFs",
+            "spindle speed (rpm)",
+            "depth (mm)",
+            &series,
+            None,
+        )?;
+        write_atomic(path, svg.as_bytes())?;
+    }
+    Ok(())
 }
 
 /// The band plot (depth against speed, with the observed cuts).
@@ -277,63 +353,18 @@ fn band_plot(title: &str, series: &[Series], obs: Option<&Observations>) -> Resu
     )
 }
 
-/// Write the band plot (the first figure) to `--plot` and the report page to `--report`.
-fn finish(
-    req: &BandRequest,
-    model: &ModalModel,
-    obs: Option<&Observations>,
-    csv: &str,
-    (lower_label, why_missing): (&str, &str),
-    figures: Vec<(String, String)>,
-    warnings: Vec<String>,
-) -> Result<()> {
-    if let (Some(path), Some((_, svg))) = (req.plot, figures.first()) {
-        write_atomic(path, svg.as_bytes())?;
-    }
-    if let Some(path) = req.report {
-        jobs::bands(&jobs::BandsResult {
-            kind: &kind_name(req.kind),
-            lower_label,
-            why_missing,
-            model,
-            observations: obs,
-            csv,
-            figures,
-            warnings,
-        })?
-        .write(path)?;
-    }
-    Ok(())
-}
-
-/// CSV of Type B offsets (001): per mean-boundary point the lower and upper boundaries at its
-/// speed (`lower_mm`, `upper_mm`, from the gap-filled, loop-free polylines), Eq. 2's angle
-/// `theta_deg` and Eq. 1's distance `distance` (rpm / um units), and the raw roots of Eq. 10-11
-/// (`upper_speed_rpm`, `upper_depth_mm`, `lower_speed_rpm`, `lower_depth_mm`), unmodified.
-pub fn geometric_csv(bands: &OffsetBoundaries) -> String {
-    let mut csv = String::from(
-        "speed_rpm,depth_mm,lower_mm,upper_mm,theta_deg,distance,upper_speed_rpm,\
-         upper_depth_mm,lower_speed_rpm,lower_depth_mm\n",
-    );
-    for p in &bands.points {
-        let lo = OffsetBoundaries::depth_at(&bands.lower, p.speed_rpm);
-        let up = OffsetBoundaries::depth_at(&bands.upper, p.speed_rpm);
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{},{},{},{}",
-            p.speed_rpm,
-            p.depth_mm,
-            cell(lo),
-            cell(up),
-            p.theta_deg,
-            p.distance,
-            p.upper.0,
-            p.upper.1,
-            p.lower.0,
-            p.lower.1
-        );
-    }
-    csv
+/// The parameter distribution of `--posterior` or `--covariance` (None when neither is given:
+/// the job says which kinds need one).
+fn distribution(req: &BandRequest, model: &ModalModel) -> Result<Option<ParameterDistribution>> {
+    Ok(match (req.posterior, req.covariance) {
+        (Some(dir), None) => {
+            validate::posterior_matches(model, dir)?;
+            Some(ParameterDistribution::from_posterior_dir(dir)?)
+        }
+        (None, Some(file)) => Some(ParameterDistribution::from_covariance_file(file)?),
+        (Some(_), Some(_)) => bail!("give either --posterior DIR or --covariance FILE, not both"),
+        (None, None) => None,
+    })
 }
 
 /// 001 Figs. 6-10: Eq. 2's angle theta and Eq. 1's offset distance d along the mean boundary,
@@ -401,100 +432,6 @@ pub fn offset_detail_svgs(stem: &str, bands: &OffsetBoundaries) -> Result<[(Stri
     ])
 }
 
-fn cell(v: Option<f64>) -> String {
-    v.map(|x| x.to_string()).unwrap_or_default()
-}
-
-/// A mean boundary with a lower and an upper curve, for plotting.
-pub fn band_series(
-    mean: Vec<(f64, f64)>,
-    lower: Vec<(f64, f64)>,
-    upper: Vec<(f64, f64)>,
-    labels: [&str; 3],
-) -> [Series; 3] {
-    let line = |label: &str, points: Vec<(f64, f64)>, color: RGBColor| Series {
-        label: label.into(),
-        points,
-        color,
-        dashed: false,
-    };
-    [
-        line(labels[0], mean, BLUE),
-        line(labels[1], lower, RGBColor(200, 0, 0)),
-        line(labels[2], upper, GREEN),
-    ]
-}
-
-fn distribution(req: &BandRequest, model: &ModalModel) -> Result<ParameterDistribution> {
-    Ok(match (req.posterior, req.covariance) {
-        (Some(dir), None) => {
-            validate::posterior_matches(model, dir)?;
-            ParameterDistribution::from_posterior_dir(dir)?
-        }
-        (None, Some(file)) => ParameterDistribution::from_covariance_file(file)?,
-        (Some(_), Some(_)) => bail!("give either --posterior DIR or --covariance FILE, not both"),
-        (None, None) => bail!(
-            "--kind {} needs a parameter distribution: --posterior DIR (from `chatter update`) \
-             or --covariance FILE ({{\"parameter_names\": [...], \"covariance\": [[...]]}})",
-            kind_name(req.kind)
-        ),
-    })
-}
-
-/// The method of a band kind that needs a discretization.
-fn discretized_method(req: &BandRequest) -> Result<Method> {
-    let method = req.method.unwrap_or(Method::Fdm);
-    if method.discretization().is_none() {
-        bail!("--kind {} needs --method fdm or sdm", kind_name(req.kind));
-    }
-    Ok(method)
-}
-
-/// `--depths` when given.
-fn depth_option(req: &BandRequest) -> Result<Option<Vec<f64>>> {
-    req.depths
-        .map(|spec| validate::grid("--depths", spec, &validate::DEPTH_GRID_MM))
-        .transpose()
-}
-
-fn perturbation(
-    req: &BandRequest,
-    model: &ModalModel,
-    speeds: &[f64],
-    obs: Option<&Observations>,
-) -> Result<()> {
-    let rule = match req.coverage {
-        Some(c) => BoundRule::coverage(c).map_err(|e| anyhow::anyhow!("--coverage: {e}"))?,
-        None => BoundRule::ComplexSd,
-    };
-    let dist = distribution(req, model)?;
-    let method = discretized_method(req)?;
-    let bar = Bar::new(speeds.len() as u64, "credibility grid", req.quiet);
-    let bands =
-        band_jobs::perturbation(model, &dist, method, rule, speeds, depth_option(req)?, &bar)
-            .map_err(crate::job_error)?;
-    bar.finish();
-    let (csv, series) = credibility_bands(&bands.bounds, rule);
-    emit(req.out, &csv)?;
-    if req.plot.is_none() && req.report.is_none() {
-        return Ok(());
-    }
-    let title = format!(
-        "Credibility bounds at the posterior mean: {}",
-        rule_title(rule)
-    );
-    let svg = band_plot(&title, &series, obs)?;
-    finish(
-        req,
-        model,
-        obs,
-        &csv,
-        ("lower credibility bound", jobs::PERTURBATION_MISSING),
-        vec![(title, svg)],
-        Vec::new(),
-    )
-}
-
 /// Plot title of a bound rule.
 pub fn rule_title(rule: BoundRule) -> String {
     match rule {
@@ -505,146 +442,4 @@ pub fn rule_title(rule: BoundRule) -> String {
         }
         BoundRule::Coverage(c) => format!("{:.0} % credibility of |mu|", 100.0 * c),
     }
-}
-
-/// Credibility bounds (second-order perturbation of the dominant multiplier, Ahmadi 2022 Eq.
-/// 14-18, [`band_jobs::perturbation`]) under `rule` as CSV
-/// `speed_rpm,depth_mm,lower_mm,upper_mm` (empty cells where a contour is not reached on the
-/// grid) and the plot series, broken (NaN) at those speeds so no line is drawn across a gap.
-pub fn credibility_bands(
-    bounds: &[chatter_uncertainty::perturbation::CredibilityPoint],
-    rule: BoundRule,
-) -> (String, [Series; 3]) {
-    let mut csv = String::from("speed_rpm,depth_mm,lower_mm,upper_mm\n");
-    for b in bounds {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{}",
-            b.speed_rpm,
-            cell(b.depth_mm),
-            cell(b.lower_mm),
-            cell(b.upper_mm)
-        );
-    }
-    let pick = |f: fn(&chatter_uncertainty::perturbation::CredibilityPoint) -> Option<f64>| {
-        bounds
-            .iter()
-            .map(|b| (b.speed_rpm, f(b).unwrap_or(f64::NAN)))
-            .collect::<Vec<_>>()
-    };
-    let (mean, lower, upper) = match rule {
-        BoundRule::ComplexSd => (
-            "limit of the mean multiplier".to_string(),
-            "lower: mean + 1 sd reaches 1".to_string(),
-            "upper: mean - 1 sd reaches 1".to_string(),
-        ),
-        BoundRule::Coverage(c) => {
-            let p = 100.0 * c;
-            (
-                "limit of the mean modulus".to_string(),
-                format!("lower ({p:.0} %)"),
-                format!("upper ({p:.0} %)"),
-            )
-        }
-    };
-    let series = band_series(
-        pick(|b| b.depth_mm),
-        pick(|b| b.lower_mm),
-        pick(|b| b.upper_mm),
-        [&mean, &lower, &upper],
-    );
-    (csv, series)
-}
-
-fn montecarlo(
-    req: &BandRequest,
-    model: &ModalModel,
-    speeds: &[f64],
-    obs: Option<&Observations>,
-) -> Result<()> {
-    let dist = distribution(req, model)?;
-    let method = discretized_method(req)?;
-    let samples = req.samples.unwrap_or(SAMPLES);
-    let bar = Bar::new(samples as u64, "Monte Carlo samples", req.quiet);
-    let mc = band_jobs::montecarlo(
-        model,
-        &dist,
-        method,
-        samples,
-        req.seed.unwrap_or(0),
-        speeds,
-        &bar,
-    )
-    .map_err(crate::job_error)?;
-    bar.finish();
-    let mut warnings = Vec::new();
-    let sampled = &mc.sampled;
-    if !sampled.failures.is_empty() {
-        // failed samples are left out of P_s and the quantiles, never counted as stable
-        let invalid = sampled
-            .failures
-            .iter()
-            .filter(|f| f.kind == FailureKind::InvalidSample)
-            .count();
-        let worst = sampled.failures_per_speed().into_iter().max().unwrap_or(0);
-        let warning = format!(
-            "{} sample-speed failures ({} numerical, {invalid} invalid samples), at most \
-             {worst} of {} samples at one speed, left out of the map; first: {}",
-            sampled.failures.len(),
-            sampled.failures.len() - invalid,
-            mc.draws,
-            sampled.failures[0].message
-        );
-        eprintln!("warning: {warning}");
-        warnings.push(warning);
-    }
-    let (depth, hz) = (&mc.depth, &mc.chatter_hz);
-    let mut csv = String::from(
-        "speed_rpm,depth_mm,lower_mm,upper_mm,chatter_hz_q05,chatter_hz_q50,chatter_hz_q95\n",
-    );
-    for (d, f) in depth.iter().zip(hz) {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{}",
-            d.speed_rpm, d.q50, d.q05, d.q95, f.q05, f.q50, f.q95
-        );
-    }
-    emit(req.out, &csv)?;
-    if let Some(path) = req.map_out {
-        let map = mc.map(depth_option(req)?).map_err(crate::job_error)?;
-        let mut text = String::from("speed_rpm,depth_mm,p_stable\n");
-        for (s, row) in map.speeds_rpm.iter().zip(&map.p_stable) {
-            for (b, p) in map.depths_mm.iter().zip(row) {
-                let _ = writeln!(text, "{s},{b},{p}");
-            }
-        }
-        write_atomic(path, text.as_bytes())?;
-    }
-    if req.plot.is_some() || req.report.is_some() {
-        let curve = |f: fn(&chatter_uncertainty::montecarlo::QuantileBand) -> f64| {
-            depth
-                .iter()
-                .map(|d| (d.speed_rpm, f(d)))
-                .filter(|p| p.1.is_finite())
-                .collect::<Vec<_>>()
-        };
-        let series = band_series(
-            curve(|d| d.q50),
-            curve(|d| d.q05),
-            curve(|d| d.q95),
-            ["P_s = 0.5", "P_s = 0.95", "P_s = 0.05"],
-        );
-        let title = "Monte Carlo probability of stability";
-        let svg = band_plot(title, &series, obs)?;
-        finish(
-            req,
-            model,
-            obs,
-            &csv,
-            ("P_s = 0.95 contour", jobs::MONTECARLO_MISSING),
-            vec![(title.into(), svg)],
-            warnings,
-        )?;
-    }
-    Ok(())
 }

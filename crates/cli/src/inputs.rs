@@ -2,6 +2,9 @@
 
 use anyhow::{Context, Result};
 use chatter_dynamics::{ModalModel, Observations};
+use chatter_frf::MeasuredModel;
+use chatter_jobs::lobes::{Dynamics, uses_measured_frf};
+use chatter_stability::Method;
 use chatter_updating::joint_prior::{JointNormal, PriorFile};
 use chatter_updating::update::PriorOverrides;
 use std::path::Path;
@@ -9,6 +12,21 @@ use std::path::Path;
 /// Read and validate a model file.
 pub fn model(path: &Path) -> Result<ModalModel> {
     ModalModel::from_path(path).context("reading the model file")
+}
+
+/// Read a model file as the dynamics `method` runs on: its measured FRFs for the zero-order
+/// method when it has `measured_frf` (`chatter_jobs::lobes::uses_measured_frf`), else its
+/// modes.
+pub fn dynamics(path: &Path, method: Method) -> Result<Dynamics> {
+    if let Ok(file) = chatter_frf::read_model_file(path)
+        && uses_measured_frf(&file, method, &path.display().to_string())
+            .map_err(crate::job_error)?
+    {
+        return Ok(Dynamics::Measured(
+            MeasuredModel::from_path(path).context("reading the measured FRFs")?,
+        ));
+    }
+    Ok(Dynamics::Modal(model(path)?))
 }
 
 /// Read and validate an observations file (JSON or cuts CSV).

@@ -1,90 +1,11 @@
-//! `chatter lobes` extras: a fixed resolution of the full/semi-discretization, and the map of
-//! the dominant multiplier's modulus |mu| over speed x depth (CSV and an SVG heat map with the
-//! |mu| = 1 boundary), the quantity the lobes are the unit contour of.
+//! The SVG heat map of `chatter lobes --map-plot`: the dominant multiplier's modulus |mu| over
+//! speed x depth (`chatter_jobs::lobes::LobeMap`) with the |mu| = 1 boundary, the quantity the
+//! lobes are the unit contour of.
 
-use crate::progress::Bar;
 use anyhow::{Result, anyhow, bail};
-use chatter_dynamics::ModalModel;
-use chatter_stability::boundary::{BoundaryOptions, LobePoint};
-use chatter_stability::prepared::{Method, PreparedDiscretization, PreparedSolver};
+use chatter_jobs::lobes::LobeMap;
+use chatter_stability::boundary::LobePoint;
 use plotters::prelude::*;
-use rayon::prelude::*;
-use std::fmt::Write as _;
-
-/// Depths of the default map: from 1/80 to 1.5x the deepest finite limit of the lobes, 80 rows.
-pub const DEFAULT_MAP_DEPTHS: usize = 80;
-
-/// `method` prepared for `model`; with `cutting_steps`, FDM or SDM with that many steps over
-/// the cutting part of one delay instead of the automatic resolution.
-pub fn solver(
-    model: &ModalModel,
-    method: Method,
-    cutting_steps: Option<std::num::NonZeroUsize>,
-) -> Result<Box<dyn PreparedSolver>> {
-    let options = BoundaryOptions::default();
-    Ok(match (method.discretization(), cutting_steps) {
-        (None, Some(_)) => {
-            bail!("--cutting-steps is not used with --method zoa; it is for fdm and sdm")
-        }
-        (Some(d), Some(m)) => Box::new(PreparedDiscretization::new(
-            d.with_steps(m),
-            model,
-            &options,
-        )?),
-        _ => method.prepare(model, &options)?,
-    })
-}
-
-/// The default map depths (m) for `lobes`; an error when no speed has a finite limit.
-pub fn default_depths_m(lobes: &[LobePoint]) -> Result<Vec<f64>> {
-    let deepest = lobes
-        .iter()
-        .map(|p| p.depth_m)
-        .filter(|d| d.is_finite())
-        .fold(0.0, f64::max);
-    if deepest <= 0.0 {
-        bail!("no speed has a stability limit below the depth ceiling; give --depths for the map");
-    }
-    Ok(chatter_stability::speed_grid::depth_grid(
-        deepest,
-        DEFAULT_MAP_DEPTHS,
-    ))
-}
-
-/// |mu| at every (speed, depth), rows per speed, in parallel.
-pub fn modulus_map(
-    solver: &dyn PreparedSolver,
-    speeds_rpm: &[f64],
-    depths_m: &[f64],
-    quiet: bool,
-) -> Result<Vec<Vec<f64>>> {
-    let bar = Bar::new(speeds_rpm.len() as u64, "|mu| map", quiet);
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let grid = speeds_rpm
-        .par_iter()
-        .map(|&s| {
-            let row = depths_m
-                .iter()
-                .map(|&b| Ok(solver.dominant_multiplier(s, b)?.modulus()))
-                .collect::<Result<Vec<f64>>>();
-            bar.set(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
-            row
-        })
-        .collect::<Result<Vec<_>>>()?;
-    bar.finish();
-    Ok(grid)
-}
-
-/// CSV `speed_rpm,depth_mm,modulus`, one row per grid point.
-pub fn csv(speeds_rpm: &[f64], depths_m: &[f64], grid: &[Vec<f64>]) -> String {
-    let mut out = String::from("speed_rpm,depth_mm,modulus\n");
-    for (s, row) in speeds_rpm.iter().zip(grid) {
-        for (b, m) in depths_m.iter().zip(row) {
-            let _ = writeln!(out, "{s},{},{m}", b * 1e3);
-        }
-    }
-    out
-}
 
 /// Colour of |mu|: white at 1, shading to blue (stable) down to 0.1 and to red (chatter) up
 /// to 10 (log scale, clipped).
@@ -100,13 +21,8 @@ fn colour(modulus: f64) -> RGBColor {
 
 /// SVG heat map of |mu| (speed across, depth up) with the limiting depths of `lobes` as a
 /// black line: blue is stable (|mu| < 1), red chatter, white the boundary.
-pub fn heat_map_svg(
-    title: &str,
-    speeds_rpm: &[f64],
-    depths_m: &[f64],
-    grid: &[Vec<f64>],
-    lobes: &[LobePoint],
-) -> Result<String> {
+pub fn heat_map_svg(title: &str, map: &LobeMap, lobes: &[LobePoint]) -> Result<String> {
+    let (speeds_rpm, depths_m, grid) = (&map.speeds_rpm[..], &map.depths_m[..], &map.grid);
     let (Some(&s0), Some(&s1)) = (speeds_rpm.first(), speeds_rpm.last()) else {
         bail!("an empty map");
     };

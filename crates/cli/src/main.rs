@@ -6,12 +6,12 @@
 mod bands;
 mod batch;
 mod commands;
+mod demo;
 mod detect;
 mod diagnose;
 mod inputs;
 mod lobe_map;
 mod measured;
-mod measured_bands;
 mod oma;
 mod output;
 mod papers;
@@ -22,13 +22,15 @@ mod rcsa;
 mod report;
 mod sensitivity;
 mod shop;
+mod tables;
 mod update;
 mod validate;
 
 use bands::BandKind;
+use chatter_stability::prepared::Method;
 use clap::{Parser, Subcommand};
-use commands::Method;
 use std::path::PathBuf;
+pub use validate::job_error;
 
 #[derive(Parser)]
 #[command(
@@ -409,25 +411,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out,
             plot,
         } => {
-            let range = match (fmin_hz, fmax_hz) {
-                (None, None) => None,
-                (a, Some(b)) => Some((
-                    validate::option("--fmin-hz", a.unwrap_or(0.0), &validate::FRF_HZ)?,
-                    validate::option("--fmax-hz", b, &validate::FRF_HZ)?,
-                )),
-                (Some(a), None) => anyhow::bail!(
-                    "--fmin-hz {} needs --fmax-hz",
-                    validate::as_typed("--fmin-hz", a)
-                ),
-            };
-            validate::count("--points", points, 2, validate::MAX_POINTS, "frequencies")?;
             output::check_optional_file("--out", out.as_deref())?;
             output::check_optional_file("--plot", plot.as_deref())?;
             commands::frf(
                 &model,
-                range,
-                points,
-                (from, to),
+                &chatter_jobs::frf::FrfRequest {
+                    fmin_hz,
+                    fmax_hz,
+                    points,
+                    response: from,
+                    force: to,
+                },
                 out.as_deref(),
                 plot.as_deref(),
             )
@@ -504,12 +498,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             ssv_frequency_ratio,
         } => commands::multiplier(
             &model,
-            validate::option(
-                "--speed-rpm",
-                speed_rpm,
-                &chatter_dynamics::limits::SPEED_RPM,
-            )?,
-            validate::option("--depth-mm", depth_mm, &chatter_dynamics::limits::DEPTH_MM)?,
+            speed_rpm,
+            depth_mm,
             method,
             shop::speed_variation(ssv_amplitude_ratio, ssv_frequency_ratio)?,
             quiet,
@@ -567,32 +557,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             harmonic_force_n,
             feed_per_tooth_mm,
         } => {
-            use chatter_dynamics::limits::{DEPTH_MM, SAMPLE_RATE_HZ, SPEED_RPM};
-            use chatter_dynamics::simulate::{Quantity, SimulationSettings};
-            validate::option("--speed-rpm", speed_rpm, &SPEED_RPM)?;
-            validate::option("--depth-mm", depth_mm, &DEPTH_MM)?;
-            validate::option("--duration-s", duration_s, &validate::DURATION_S)?;
-            validate::option("--sample-rate-hz", sample_rate_hz, &SAMPLE_RATE_HZ)?;
-            validate::option("--random-force-n", random_force_n, &validate::FORCE_N)?;
-            validate::option("--harmonic-force-n", harmonic_force_n, &validate::FORCE_N)?;
-            validate::option("--feed-per-tooth-mm", feed_per_tooth_mm, &validate::FEED_MM)?;
-            validate::simulation_length(duration_s, sample_rate_hz)?;
-            output::check_file("--out", &out)?;
-            let mut s = SimulationSettings::new(
-                speed_rpm,
-                depth_mm * 1e-3,
-                duration_s,
-                sample_rate_hz,
-                seed,
-            );
-            s.quantity = match quantity {
-                QuantityArg::Acceleration => Quantity::Acceleration,
-                QuantityArg::Velocity => Quantity::Velocity,
-                QuantityArg::Displacement => Quantity::Displacement,
+            use chatter_dynamics::simulate::Quantity;
+            let request = chatter_jobs::simulate::SimulateRequest {
+                quantity: match quantity {
+                    QuantityArg::Acceleration => Quantity::Acceleration,
+                    QuantityArg::Velocity => Quantity::Velocity,
+                    QuantityArg::Displacement => Quantity::Displacement,
+                },
+                random_force_n,
+                harmonic_force_n,
+                feed_per_tooth_mm,
+                ..chatter_jobs::simulate::SimulateRequest::new(
+                    speed_rpm,
+                    depth_mm,
+                    duration_s,
+                    sample_rate_hz,
+                    seed,
+                )
             };
-            s.random_force_rms_n = random_force_n;
-            s.harmonic_force_n = harmonic_force_n;
-            s.feed_per_tooth_m = feed_per_tooth_mm * 1e-3;
+            let s = request.check().map_err(job_error)?;
+            output::check_file("--out", &out)?;
             commands::simulate(&model, &s, &out, quiet)
         }
         Command::Diagnose {
@@ -628,7 +612,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::FitFrf(args) => measured::fit_frf(&args),
         Command::Rcsa(args) => rcsa::rcsa(&args),
         Command::Batch(args) => batch::run(&args, quiet),
-        Command::Demo { out } => commands::demo(&out, quiet),
+        Command::Demo { out } => demo::demo(&out, quiet),
         Command::Serve {
             host,
             port,
@@ -667,19 +651,6 @@ fn command() -> clap::Command {
         }
         sub
     })
-}
-
-/// A job's error in the command line's words: an invalid request field is reported as its
-/// option (`samples` as `--samples`), the rest as it is.
-pub fn job_error(e: chatter_jobs::JobError) -> anyhow::Error {
-    match e {
-        chatter_jobs::JobError::Invalid {
-            field,
-            value,
-            expected,
-        } => anyhow::anyhow!("--{} {value}: expected {expected}", field.replace('_', "-")),
-        other => other.into(),
-    }
 }
 
 /// The error and its causes on one line, each cause once: a cause whose text its parent

@@ -1,65 +1,14 @@
-//! Measured FRFs in the CLI: `chatter lobes --method zoa` on a model whose `measured_frf` gives
-//! its dynamics, and `chatter fit-frf` (modal fit, model file, overlay plot).
+//! `chatter fit-frf`: modal fit of a measured FRF, model file, overlay plot.
 
-use crate::commands::Method;
 use crate::output::write_atomic;
 use crate::plot::{Series, line_chart};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use chatter_dynamics::ModelFile;
-use chatter_dynamics::model_file::{ModeFile, ResidualFile};
-use chatter_frf::{FitOptions, MeasuredModel, ModalFit, fit_modes, read_frf, read_model_file};
-use chatter_stability::boundary::LobePoint;
-use chatter_stability::zero_order::{ZeroOrderOptions, measured_limiting_depths};
+use chatter_frf::{read_frf, read_model_file};
+use chatter_jobs::JobError;
+use chatter_jobs::fit_frf::{self, FitFrfRequest};
 use plotters::style::{BLUE, GREEN, RED};
-use std::path::{Path, PathBuf};
-
-/// Zero-order lobes from the model's measured FRFs when it has them: None for a modal model;
-/// an error for other methods on a model without modes.
-pub fn lobes(
-    model_path: &Path,
-    method: Method,
-    speeds: Option<&str>,
-) -> Result<Option<Vec<LobePoint>>> {
-    let file = read_model_file(model_path).context("reading the model file")?;
-    if file.measured_frf.is_none() {
-        return Ok(None);
-    }
-    if method != Method::Zoa {
-        if file.modes.is_empty() {
-            bail!(
-                "{}: --method {} needs modal parameters, and this model gives its dynamics as \
-                 measured_frf only; use --method zoa (zero-order lobes straight from the FRF), or \
-                 fit modes with `chatter fit-frf` and add them as `modes`",
-                model_path.display(),
-                format!("{method:?}").to_lowercase()
-            );
-        }
-        // a model with both: the modes serve the time-domain methods
-        return Ok(None);
-    }
-    let model = MeasuredModel::from_path(model_path).context("reading the measured FRFs")?;
-    let speeds = match speeds {
-        Some(s) => crate::validate::speeds(s)?,
-        None => default_speeds(&model),
-    };
-    Ok(Some(measured_limiting_depths(
-        &model.operation,
-        model.cutting,
-        &model.receptance,
-        &speeds,
-        // the depth ceiling of every `lobes` method (see `commands::warn_unbounded`)
-        &ZeroOrderOptions::default(),
-    )?))
-}
-
-/// The default speeds around the receptance's peak
-/// (`chatter_stability::speed_grid::even_lobe_speeds_rpm`).
-pub fn default_speeds(model: &MeasuredModel) -> Vec<f64> {
-    chatter_stability::speed_grid::even_lobe_speeds_rpm(
-        model.receptance.peak_frequency_hz(),
-        model.operation.delays_per_revolution() as f64,
-    )
-}
+use std::path::PathBuf;
 
 /// Arguments of `chatter fit-frf`.
 #[derive(Debug, clap::Args)]
@@ -117,113 +66,43 @@ pub enum ModeForm {
     Complex,
 }
 
-/// The fitted modes as model-file entries along `direction`, complex or real; real modes with a
-/// negative modal mass are left out.
-fn mode_entries(fit: &ModalFit, complex: bool, direction: &str) -> Result<Vec<ModeFile>> {
-    let mut entries = Vec::new();
-    for m in &fit.modes {
-        let mode = if complex {
-            m.complex_mode(0)?
-        } else {
-            match m.real_mode(0) {
-                Some(mode) => mode,
-                None => continue,
-            }
-        };
-        entries.push(ModeFile {
-            frequency_hz: mode.frequency_hz(),
-            damping_ratio: mode.damping_ratio(),
-            // the mode moves coordinate 0 only: its stiffness there is the directional one
-            stiffness_n_per_m: Some(mode.stiffness_at(0)),
-            direction: Some(direction.to_string()),
-            shape: None,
-            residue_phase_deg: (!mode.is_proportional())
-                .then(|| mode.residue_phase_rad().to_degrees()),
-        });
-    }
-    Ok(entries)
-}
-
 /// `chatter fit-frf`: prints the fit report (complex modes, residual terms, misfits) as JSON.
 pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
-    let fmin = crate::validate::option("--fmin-hz", args.fmin_hz, &crate::validate::FRF_HZ)?;
-    let fmax = crate::validate::option("--fmax-hz", args.fmax_hz, &crate::validate::FRF_HZ)?;
-    if fmax <= fmin {
-        bail!(
-            "--fmax-hz {}: expected above --fmin-hz {}",
-            crate::validate::as_typed("--fmax-hz", fmax),
-            crate::validate::as_typed("--fmin-hz", fmin)
-        );
-    }
-    if let Some(n) = args.modes {
-        crate::validate::count("--modes", n, 1, 50, "modes")?;
-    }
+    let request = FitFrfRequest {
+        fmin_hz: args.fmin_hz,
+        fmax_hz: args.fmax_hz,
+        modes: args.modes,
+        direction: args.direction.clone(),
+        mode_form: match args.mode_form {
+            ModeForm::Auto => fit_frf::ModeForm::Auto,
+            ModeForm::Real => fit_frf::ModeForm::Real,
+            ModeForm::Complex => fit_frf::ModeForm::Complex,
+        },
+        with_residuals: args.with_residuals,
+    };
+    let job = request.check().map_err(crate::job_error)?;
     crate::output::check_file("--out", &args.out)?;
     crate::output::check_optional_file("--plot", args.plot.as_deref())?;
     let frf = read_frf(&args.frf, args.dataset).context("reading the FRF")?;
-    let options = FitOptions {
-        modes: args.modes,
-        ..FitOptions::default()
+    let outcome = match job.run(&frf) {
+        Ok(o) => o,
+        Err(e @ (JobError::Invalid { .. } | JobError::Refused(_))) => {
+            return Err(crate::job_error(e)).with_context(|| args.frf.display().to_string());
+        }
+        Err(e) => {
+            return Err(crate::job_error(e))
+                .with_context(|| format!("fitting {}", args.frf.display()));
+        }
     };
-    let fit = fit_modes(&frf, args.fmin_hz, args.fmax_hz, &options)
-        .with_context(|| format!("fitting {}", args.frf.display()))?;
-    let complex = match args.mode_form {
-        ModeForm::Auto => fit.needs_complex_modes(),
-        ModeForm::Real => false,
-        ModeForm::Complex => true,
-    };
-    if args.with_residuals && !complex {
-        bail!(
-            "--with-residuals: the residual terms were fitted with the complex modes, and real \
-             modes are written (--mode-form {}); use --mode-form complex",
-            if args.mode_form == ModeForm::Real {
-                "real"
-            } else {
-                "auto chose real"
-            }
-        );
-    }
-    let residual = args.with_residuals.then(|| ResidualFile {
-        direction: args.direction.clone(),
-        upper_m_per_n: fit.upper_residual_m_per_n,
-        lower_per_kg: fit.lower_residual_per_kg,
-    });
-    let modes = mode_entries(&fit, complex, &args.direction)?;
-    if modes.is_empty() {
-        bail!(
-            "{}: no fitted mode is a real mode with positive modal mass; nothing to write",
-            args.frf.display()
-        );
-    }
-    let dropped = fit.modes.len() - modes.len();
+    let (fit, complex) = (&outcome.fit, outcome.complex);
     let json = match &args.model {
         Some(base) => {
-            let mut file: ModelFile = read_model_file(base).context("reading --model")?;
-            let direction = Some(args.direction.clone());
-            // modes along this direction (directional, or a shape that moves it) are replaced
-            file.modes.retain(|m| {
-                m.direction != direction
-                    && m.shape
-                        .as_ref()
-                        .is_none_or(|s| s.get(&args.direction).is_none_or(|v| *v == 0.0))
-            });
-            file.modes.extend(modes);
-            // the residual terms of this direction belonged to the replaced modes
-            let mut residuals: Vec<ResidualFile> = file
-                .residuals
-                .take()
-                .unwrap_or_default()
-                .into_iter()
-                .filter(|r| r.direction != args.direction)
-                .chain(residual)
-                .collect();
-            residuals.sort_by(|a, b| a.direction.cmp(&b.direction));
-            file.residuals = (!residuals.is_empty()).then_some(residuals);
-            file.measured_frf = None;
-            // validate the result before writing it
-            file.validate()
+            let file: ModelFile = read_model_file(base).context("reading --model")?;
+            let merged = outcome
+                .merged_into(file, &args.direction)
+                .map_err(crate::job_error)
                 .with_context(|| format!("the fitted modes in the model of {}", base.display()))?;
-            serde_json::to_string_pretty(&file)?
+            serde_json::to_string_pretty(&merged)?
         }
         None => {
             eprintln!(
@@ -231,8 +110,8 @@ pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
                  cutting (or pass --model) to use it as a model file",
                 args.out.display()
             );
-            let mut json = serde_json::json!({ "modes": modes });
-            if let Some(r) = residual {
+            let mut json = serde_json::json!({ "modes": outcome.modes });
+            if let Some(r) = &outcome.residual {
                 json["residuals"] = serde_json::json!([r]);
             }
             serde_json::to_string_pretty(&json)?
@@ -250,7 +129,7 @@ pub fn fit_frf(args: &FitFrfArgs) -> Result<()> {
         "nrmse_complex_modes": fit.complex_mode_relative_misfit,
         "modes_in_model": if complex { "complex" } else { "real" },
         "residuals_in_model": args.with_residuals,
-        "modes_dropped_from_model": dropped,
+        "modes_dropped_from_model": outcome.dropped,
     });
     println!("{}", serde_json::to_string_pretty(&report)?);
     if let Some(p) = &args.plot {

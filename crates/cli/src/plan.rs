@@ -63,7 +63,7 @@ pub struct PlanArgs {
     /// Stability method of the sampled boundaries: fdm (default), sdm, or zoa (the
     /// zero-order method 004 used; complex modes need it).
     #[arg(long, value_enum)]
-    method: Option<crate::commands::Method>,
+    method: Option<chatter_stability::prepared::Method>,
     /// Seed of the prior samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -166,13 +166,13 @@ pub fn run(args: &PlanArgs, quiet: bool) -> Result<()> {
     validate::option(
         "--feed-per-tooth-mm",
         args.feed_per_tooth_mm,
-        &validate::FEED_MM,
+        &chatter_jobs::simulate::FEED_MM,
     )?;
     let speeds = args.speeds.as_deref().map(validate::speeds).transpose()?;
     let depths = args
         .depths
         .as_deref()
-        .map(|s| validate::grid("--depths", s, &validate::DEPTH_GRID_MM))
+        .map(|s| validate::grid("--depths", s, &chatter_jobs::checks::DEPTH_GRID_MM))
         .transpose()?;
     let model = crate::inputs::model(&args.model)?;
     let observations = match &args.observations {

@@ -33,7 +33,7 @@ pub fn sle(r: &SleRequest) -> Result<()> {
     let feed_mm = validate::option(
         "--feed-per-tooth-mm",
         r.feed_per_tooth_mm,
-        &validate::FEED_MM,
+        &chatter_jobs::simulate::FEED_MM,
     )?;
     let speeds = validate::speeds(r.speeds)?;
     let model = inputs::model(r.model)?;
@@ -96,7 +96,7 @@ pub fn recommend(r: &RecommendRequest) -> Result<()> {
     let feed_mm = validate::option(
         "--feed-per-tooth-mm",
         r.feed_per_tooth_mm,
-        &validate::FEED_MM,
+        &chatter_jobs::simulate::FEED_MM,
     )?;
     let mut options = RecommendOptions::new(max_depth_mm * 1e-3);
     options.feed_per_tooth_m = feed_mm * 1e-3;

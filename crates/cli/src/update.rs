@@ -50,7 +50,7 @@ pub struct UpdateArgs {
     /// Stability method of the cut likelihood (cut results only): fdm (default), sdm, or zoa
     /// (the zero-order method 004 used; complex modes and residual terms need it).
     #[arg(long, value_enum)]
-    method: Option<crate::commands::Method>,
+    method: Option<chatter_stability::prepared::Method>,
     /// Model classes alpha, comma-separated; default 2^-5.5..2^2 (turning), 0.001..1 (milling).
     #[arg(long)]
     classes: Option<String>,

@@ -1,23 +1,17 @@
-//! Checks of the command-line options before any work starts: ranges in the units the user
-//! wrote (`--depth-mm -1` is reported as `-1`, not as metres), limits on the work a command may
-//! start (points, samples, steps per delay), options the chosen kind would ignore, and
-//! consistency between the files given together (operation kind, coordinates).
+//! Parsing and checks of the command-line options that no job request holds: `MIN:MAX:N` grids,
+//! values echoed as typed (`--depth-mm -1` is reported as `-1`, not as metres), ranges of the
+//! commands not yet behind a request, options that concern outputs, and consistency between the
+//! files given together (operation kind, coordinates). The ranges, the cost guard and the
+//! refused combinations of the requests live with them in `chatter_jobs` (`checks`).
 //!
 //! Ranges of file contents live with their types (`chatter_dynamics::limits`); this module
 //! reuses them for the options that carry the same quantities.
 
 use anyhow::{Result, bail};
-use chatter_dynamics::limits::{Plausible, SPEED_RPM, closed, open_closed, written};
+use chatter_dynamics::limits::{Plausible, SPEED_RPM, open_closed, written};
 use chatter_dynamics::{ModalModel, Observations, Operation};
 use chatter_stability::monodromy::Discretization;
 
-/// Most cutting steps per delay a discretization may use. The cost of one multiplier grows as
-/// the square of the steps (measured on the seed-000 turning model, debug build: 1 400 steps
-/// 0.5 s, 5 000 steps 2.9 s, 10 000 steps 11 s), and a lobe diagram needs thousands of
-/// multipliers, so beyond this a run is a hang in all but name.
-pub const MAX_STEPS_PER_DELAY: usize = 10_000;
-/// Most frequencies of `chatter frf`.
-pub const MAX_POINTS: usize = 1_000_000;
 /// Most speeds or depths of a `MIN:MAX:N` grid.
 pub const MAX_GRID: usize = 10_000;
 
@@ -71,24 +65,10 @@ pub fn count(flag: &str, value: usize, min: usize, max: usize, what: &str) -> Re
     }
 }
 
-/// Signal length of `chatter simulate`.
-pub const DURATION_S: Plausible = open_closed(0.0, 3600.0, "a signal length", "s");
-/// Feed per tooth (milling) or per revolution (turning).
-pub const FEED_MM: Plausible = open_closed(0.0, 10.0, "a feed", "mm");
-/// RMS or amplitude of a simulated force (zero allowed).
-pub const FORCE_N: Plausible = closed(0.0, 1e6, "a force", "N");
-/// Frequencies of `chatter frf` (zero allowed).
-pub const FRF_HZ: Plausible = closed(0.0, 1e6, "a frequency", "Hz");
 /// Width in depth of a cut likelihood (003's sigma, 004's s_S).
 pub const SIGMA_DEPTH_MM: Plausible = open_closed(0.0, 100.0, "a likelihood width", "mm");
 /// Chatter-frequency width of a cut likelihood (004's s_fc).
 pub const SIGMA_CHATTER_HZ: Plausible = open_closed(0.0, 1e5, "a likelihood width", "Hz");
-/// Speed offset of the Type B bands.
-pub const OFFSET_RPM: Plausible = closed(0.0, 1e5, "a speed offset", "rpm");
-/// Depth offset of the Type B bands.
-pub const OFFSET_MM: Plausible = closed(0.0, 100.0, "a depth offset", "mm");
-/// Depths of a `--depths` grid (zero allowed as its first value).
-pub const DEPTH_GRID_MM: Plausible = closed(0.0, 1000.0, "a depth of cut", "mm");
 /// Probability of stability of a tested contour.
 pub const PROBABILITY: Plausible = Plausible {
     min: 0.0,
@@ -98,24 +78,6 @@ pub const PROBABILITY: Plausible = Plausible {
     what: "a probability",
     unit: "",
 };
-
-/// Most output samples of `chatter simulate` (duration times sample rate).
-pub const MAX_SIMULATED_SAMPLES: f64 = 1e8;
-
-/// The simulated signal is at least 2 and at most [`MAX_SIMULATED_SAMPLES`] samples long.
-pub fn simulation_length(duration_s: f64, sample_rate_hz: f64) -> Result<()> {
-    let samples = duration_s * sample_rate_hz;
-    if !(2.0..=MAX_SIMULATED_SAMPLES).contains(&samples) {
-        bail!(
-            "--duration-s {} at --sample-rate-hz {}: {} samples; expected 2 to {} samples",
-            written(duration_s),
-            written(sample_rate_hz),
-            written(samples.floor()),
-            written(MAX_SIMULATED_SAMPLES)
-        );
-    }
-    Ok(())
-}
 
 /// An option given where the chosen kind does not use it.
 pub fn unused(given: bool, flag: &str, context: &str, used_by: &str) -> Result<()> {
@@ -156,9 +118,7 @@ pub fn grid(flag: &str, spec: &str, range: &Plausible) -> Result<Vec<f64>> {
     if !(2..=MAX_GRID).contains(&n) {
         bail!("{flag} {spec}: N {n}: expected 2 to {MAX_GRID} points");
     }
-    Ok((0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect())
+    Ok(chatter_dynamics::grid::evenly_spaced(lo, hi, n))
 }
 
 /// `--speeds MIN:MAX:N` within the plausible spindle speeds.
@@ -166,30 +126,16 @@ pub fn speeds(spec: &str) -> Result<Vec<f64>> {
     grid("--speeds", spec, &SPEED_RPM)
 }
 
-/// Refuse speeds at which `method` would need more than [`MAX_STEPS_PER_DELAY`] steps per delay
-/// (the step count grows as 1 / speed); `source` names where the speeds came from.
+/// The cost guard of the jobs ([`chatter_jobs::checks::work_size`]) for the commands that run
+/// solvers outside a job request; `flag` names where the speeds came from.
 pub fn work_size(
     model: &ModalModel,
     method: Discretization,
     speeds: &[f64],
-    source: &str,
+    flag: &str,
 ) -> Result<()> {
-    let Some(&slowest) = speeds.iter().min_by(|a, b| a.total_cmp(b)) else {
-        return Ok(());
-    };
-    let steps = method.steps_at(model, slowest).get();
-    if steps > MAX_STEPS_PER_DELAY {
-        // steps per delay scale as 1 / speed
-        let lowest = slowest * steps as f64 / MAX_STEPS_PER_DELAY as f64;
-        bail!(
-            "{source}: at {} rpm one delay needs {steps} steps of the discretization (at most \
-             {MAX_STEPS_PER_DELAY}): give speeds of at least {} rpm, or use --method zoa where \
-             the command offers it",
-            written(slowest),
-            written(lowest.ceil())
-        );
-    }
-    Ok(())
+    chatter_jobs::checks::work_size(model, method, speeds, flag.trim_start_matches("--"))
+        .map_err(crate::job_error)
 }
 
 /// [`work_size`] at the speeds of the observations' cuts and poles, for the commands that
@@ -199,13 +145,8 @@ pub fn observation_work_size(
     observations: &Observations,
     path: &std::path::Path,
 ) -> Result<()> {
-    let speeds = observations.speeds_rpm();
-    work_size(
-        model,
-        Discretization::full(),
-        &speeds,
-        &format!("{} (observed speeds)", path.display()),
-    )
+    chatter_jobs::checks::observation_work_size(model, observations, &path.display().to_string())
+        .map_err(crate::job_error)
 }
 
 /// The model and the observations describe the same operation (see
@@ -255,6 +196,88 @@ pub fn posterior_matches(model: &ModalModel, dir: &std::path::Path) -> Result<()
         );
     }
     Ok(())
+}
+
+/// A job's error in the command line's words: a request field is reported as its option
+/// (`samples` as `--samples`, the value echoed as typed), and the fields the job's messages
+/// quote in backticks likewise (`` `kind` geometric `` as `--kind geometric`); the rest as it is.
+pub fn job_error(e: chatter_jobs::JobError) -> anyhow::Error {
+    use chatter_jobs::JobError;
+    match e {
+        JobError::Invalid {
+            field,
+            value,
+            expected,
+        } => {
+            let flag = flag(field);
+            let value = match value.parse::<f64>() {
+                Ok(v) => as_typed(&flag, v),
+                Err(_) => value,
+            };
+            anyhow::anyhow!("{flag} {value}: expected {}", flags(&expected))
+        }
+        JobError::Unused {
+            field,
+            context,
+            used_by,
+        } => anyhow::anyhow!(
+            "{} is not used {}; it is for {}",
+            flag(field),
+            flags(&context),
+            flags(&used_by)
+        ),
+        JobError::TooManySteps { ref field, .. } => {
+            let text = e.to_string();
+            let source = if is_field(field) {
+                flag(field)
+            } else {
+                field.clone()
+            };
+            anyhow::anyhow!(
+                "{source}{}",
+                flags(&text[field.len()..])
+                    .replace("where the job offers", "where the command offers")
+            )
+        }
+        JobError::Refused(_) | JobError::Missing { .. } => {
+            anyhow::anyhow!("{}", flags(&e.to_string()))
+        }
+        other => other.into(),
+    }
+}
+
+/// Whether `name` is a request field (lower-case words joined by `_`).
+fn is_field(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// The option of request field `field` (`offset_rpm` -> `--offset-rpm`).
+fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
+/// `text` with every field quoted in backticks written as its option.
+fn flags(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(open) = rest.find('`') {
+        let Some(close) = rest[open + 1..].find('`') else {
+            break;
+        };
+        let inner = &rest[open + 1..open + 1 + close];
+        out.push_str(&rest[..open]);
+        if is_field(inner) {
+            out.push_str(&flag(inner));
+        } else {
+            out.push_str(&rest[open..open + close + 2]);
+        }
+        rest = &rest[open + close + 2..];
+    }
+    out.push_str(rest);
+    out
 }
 
 #[cfg(test)]

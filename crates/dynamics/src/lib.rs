@@ -30,6 +30,7 @@ pub mod cutting;
 pub mod error;
 pub mod examples;
 mod frf;
+pub mod grid;
 pub mod limits;
 pub mod model;
 pub mod model_file;

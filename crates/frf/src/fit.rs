@@ -292,7 +292,7 @@ fn lscf_poles(l: &Lags, n: usize, dt: f64) -> Option<Vec<Complex64>> {
             .complex_eigenvalues()
             .iter()
             .filter(|z| z.norm() > 0.0)
-            .map(|z| z.ln() / dt)
+            .map(|z| chatter_dynamics::pole::multiplier_pole(*z, dt))
             .collect(),
     )
 }

@@ -57,17 +57,12 @@ pub fn detect_record(
     if let Some(m) = model {
         channels_match(m, &signals.names, &format!("signals[{i}]"))?;
     }
-    let mut options = if request.estimate_speed {
-        DetectionOptions::unknown_speed()
-    } else {
-        DetectionOptions::new(record.speed_rpm / 60.0)
-    };
-    options.once_per_rev_channel = record.once_per_rev_channel.clone();
-    options.interference = request.interference.clone();
-    options.teeth = model.and_then(|m| match m.operation() {
-        Operation::Milling(milling) => Some(milling.teeth()),
-        _ => None,
-    });
+    let options = options(
+        record.speed_rpm,
+        record.once_per_rev_channel.clone(),
+        model,
+        request,
+    );
     let detection = detect_with_observer(&signals, &options, observer)?;
     let cut = cut_of(
         record,
@@ -80,6 +75,49 @@ pub fn detect_record(
         detection,
         cut,
     })
+}
+
+/// The detection options of a record at `speed_rpm` (ignored with
+/// [`DetectRequest::estimate_speed`]) with its tachometer channel, if any: the request's
+/// interference, and a milling `model`'s tooth count for flip chatter.
+fn options(
+    speed_rpm: f64,
+    once_per_rev_channel: Option<String>,
+    model: Option<&ModalModel>,
+    request: &DetectRequest,
+) -> DetectionOptions {
+    let mut options = if request.estimate_speed {
+        DetectionOptions::unknown_speed()
+    } else {
+        DetectionOptions::new(speed_rpm / 60.0)
+    };
+    options.once_per_rev_channel = once_per_rev_channel;
+    options.interference = request.interference.clone();
+    options.teeth = model.and_then(|m| match m.operation() {
+        Operation::Milling(milling) => Some(milling.teeth()),
+        _ => None,
+    });
+    options
+}
+
+/// Judge signals already in memory (`chatter.detect`): the record's channels at `speed_rpm`
+/// with its tachometer channel, if any, and a milling `model`'s tooth count, as
+/// [`detect_record`] judges a record of a file.
+pub fn detect_signals(
+    signals: &Signals,
+    speed_rpm: f64,
+    once_per_rev_channel: Option<String>,
+    model: Option<&ModalModel>,
+    request: &DetectRequest,
+    observer: &dyn Observer,
+) -> Result<Detection> {
+    let options = options(speed_rpm, once_per_rev_channel, model, request);
+    Ok(detect_with_observer(signals, &options, observer)?)
+}
+
+/// The verdict rule: a record is a stable cut when detection judged it so.
+pub fn is_stable(d: &Detection) -> bool {
+    d.verdict == Verdict::Stable
 }
 
 /// The labelled cut of a judged record: the line that decided (the whole record's, the
@@ -121,7 +159,7 @@ pub fn cut_of(
     Cut {
         speed_rpm,
         depth_mm: record.depth_mm,
-        stable: d.verdict == Verdict::Stable,
+        stable: is_stable(d),
         chatter_hz: d.chatter_hz,
         sequence: record.sequence,
         radial_immersion: record.radial_immersion,

@@ -13,6 +13,55 @@ pub enum JobError {
         /// What was expected.
         expected: String,
     },
+    /// An option given where the chosen kind does not use it.
+    #[error("{field} is not used {context}; it is for {used_by}")]
+    Unused {
+        /// The field (Python keyword; the CLI option with hyphens).
+        field: &'static str,
+        /// When it is not used (`with kind geometric`).
+        context: String,
+        /// What uses it.
+        used_by: String,
+    },
+    /// An input the job needs was not given.
+    #[error("{needed_by} needs {what}")]
+    Missing {
+        /// What is missing ("a parameter distribution").
+        what: &'static str,
+        /// What needs it (`` `kind` perturbation ``).
+        needed_by: String,
+    },
+    /// A name that is not one of the known ones.
+    #[error("{what} `{value}` is not one of {known:?}")]
+    NotOneOf {
+        /// What is named ("coordinate").
+        what: &'static str,
+        /// The name given.
+        value: String,
+        /// The names known.
+        known: Vec<String>,
+    },
+    /// Two fields that exclude each other, or a combination the job cannot do.
+    #[error("{0}")]
+    Refused(String),
+    /// The cost guard: a discretization would need more than
+    /// [`crate::checks::MAX_STEPS_PER_DELAY`] steps per delay at the slowest speed.
+    #[error(
+        "{field}: at {speed_rpm} rpm one delay needs {steps} steps of the discretization (at \
+         most {max}): give speeds of at least {lowest_rpm} rpm, or use `method` zoa where the \
+         job offers it",
+        max = crate::checks::MAX_STEPS_PER_DELAY
+    )]
+    TooManySteps {
+        /// Where the speeds came from (`speeds`, `speed_rpm`, an observations file).
+        field: String,
+        /// The slowest speed as written.
+        speed_rpm: String,
+        /// Steps per delay it needs.
+        steps: usize,
+        /// The lowest speed within the limit, as written.
+        lowest_rpm: String,
+    },
     /// A file could not be read.
     #[error("{path}: {message}")]
     File {
@@ -36,6 +85,9 @@ pub enum JobError {
     /// Gap diagnosis.
     #[error(transparent)]
     Gap(#[from] chatter_gap::GapError),
+    /// Measured FRFs and modal fits.
+    #[error(transparent)]
+    Frf(#[from] chatter_frf::FrfError),
     /// Operational modal analysis and chatter detection.
     #[error(transparent)]
     Oma(#[from] chatter_oma::OmaError),

@@ -4,6 +4,20 @@
 //! same request gives the same numbers bit for bit; they differ only in how they parse and
 //! write.
 //!
+//! Each job has a request struct with the options in user units and their defaults (one home
+//! for the defaults), checked once into the job (linfa's checked parameters, `ParamGuard`):
+//! [`lobes::Lobes::new`], [`bands::Bands::new`], [`multiplier::Multiplier::new`],
+//! [`fit_frf::FitFrfRequest::check`], [`simulate::SimulateRequest::check`],
+//! [`update::PreparedUpdate::new`]. The checks are those of [`checks`]: ranges, the cost guard
+//! [`checks::MAX_STEPS_PER_DELAY`] and the combinations a job refuses. Outcomes are typed
+//! (`LobesOutcome`, `BandsOutcome` with its `curves()`, `MultiplierOutcome`, ...), so summaries
+//! are computed from numbers, never from the text a front end wrote.
+//!
+//! - [`lobes`]: limiting depths per speed (modes or measured FRFs) and the |mu| map.
+//! - [`multiplier`]: the dominant multiplier of one cut and the stability rule |mu| < 1.
+//! - [`fit_frf`]: modes fitted to a measured FRF, merged into a model file.
+//! - [`frf`]: the receptance of a modal model on a frequency grid.
+//! - [`checks`]: the checks every request runs once (ranges, the cost guard, ignored options).
 //! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
 //! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]), also from recordings.
 //! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
@@ -12,6 +26,8 @@
 //! - [`detect`]: chatter detection of a signal record, as a labelled cut with its evidence.
 //! - [`recordings`]: a shop's recordings to labelled cuts and identified poles, one row per
 //!   record.
+//! - [`simulate`]: a time-domain regenerative cut from checked options.
+//! - [`synthetic`]: the synthetic shop-floor campaign of the proving ground (demo and Python).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
 //! - [`inference_data`]: posteriors as ArviZ `InferenceData` netCDF-4 files.
 
@@ -19,13 +35,20 @@
 
 pub mod bands;
 pub mod campaign;
+pub mod checks;
 pub mod detect;
 pub mod diagnose;
 pub mod error;
+pub mod fit_frf;
+pub mod frf;
 pub mod inference_data;
+pub mod lobes;
+pub mod multiplier;
 pub mod oma;
 pub mod plan;
 pub mod recordings;
+pub mod simulate;
+pub mod synthetic;
 pub mod update;
 
 pub use error::{JobError, Result};

@@ -14,6 +14,20 @@
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
+/// The continuous-time pole lambda = ln(mu) / T (rad/s, principal branch) of a multiplier mu
+/// over a period T in s: a discrete-time pole of a sample interval (LSCE, LSCF) or a Floquet
+/// multiplier of a delay period (000 Eq. 6, 002 Section 2.1). The one home of the conversion.
+///
+/// ```
+/// use chatter_modal::pole::{multiplier_pole, pole_from_frequency_damping};
+/// let lambda = pole_from_frequency_damping(50.0, 0.05);
+/// let mu = (lambda * 1e-3).exp();
+/// assert!((multiplier_pole(mu, 1e-3) - lambda).norm() < 1e-9 * lambda.norm());
+/// ```
+pub fn multiplier_pole(mu: Complex64, period_s: f64) -> Complex64 {
+    mu.ln() / period_s
+}
+
 /// (frequency |lambda| / 2 pi in Hz, damping ratio -Re(lambda) / |lambda|) of a pole (rad/s);
 /// (0, 1) at lambda = 0.
 pub fn pole_frequency_damping(lambda: Complex64) -> (f64, f64) {

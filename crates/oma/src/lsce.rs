@@ -14,7 +14,7 @@
 //! annihilates the harmonic components, and U (order 2P - 2H) is fitted to the filtered sequence.
 
 use crate::error::{OmaError, Result};
-use chatter_modal::pole::pole_frequency_damping;
+use chatter_modal::pole::{multiplier_pole, pole_frequency_damping};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -37,7 +37,7 @@ pub struct Pole {
 impl Pole {
     /// The pole of a discrete multiplier at sample interval `ts`.
     pub fn from_multiplier(mu: Complex64, ts: f64, harmonic: bool) -> Self {
-        let lambda = mu.ln() / ts;
+        let lambda = multiplier_pole(mu, ts);
         let (frequency_hz, damping_ratio) = pole_frequency_damping(lambda);
         Self {
             multiplier: mu,

@@ -427,5 +427,5 @@ pub fn speed_range(min_rpm: f64, max_rpm: f64, n: usize) -> Result<Vec<f64>> {
             expected: "0 < min < max and at least 2 speeds",
         });
     }
-    Ok(crate::speed_grid::evenly_spaced(min_rpm, max_rpm, n))
+    Ok(chatter_dynamics::grid::evenly_spaced(min_rpm, max_rpm, n))
 }

@@ -57,7 +57,7 @@ impl DominantMultiplier {
 
     /// Equivalent continuous-time exponent lambda = ln(mu) / tau (principal branch).
     pub fn exponent(&self) -> Complex64 {
-        self.value.ln() / self.period_s
+        chatter_dynamics::pole::multiplier_pole(self.value, self.period_s)
     }
 
     /// The family of frequencies f_mu + k / tau, k in `harmonics`, folded to non-negative values:

@@ -2,7 +2,8 @@
 //!
 //! Speeds: [`lobe_speeds_rpm`] resolves every lobe; [`default_speeds_rpm`] and
 //! [`even_lobe_speeds_rpm`] are 200 evenly spaced speeds over the same range
-//! ([`lobe_range_rpm`]). Depths: [`depth_grid`] up to 1.5 times the deepest limit.
+//! ([`lobe_range_rpm`]). Depths: [`depth_grid`] up to 1.5 times the deepest limit
+//! ([`deepest_limit_m`]), [`depth_grid_to`] to any top, [`covering_depths_mm`] around every lobe.
 //!
 //! The lobes of a mode f (Hz) at z delays per revolution lie at lobe numbers
 //! N = 60 f / (z n) (n in rpm), one lobe per unit of N, so in speed they crowd together as
@@ -11,8 +12,9 @@
 //! against lobes ~330 rpm apart at 7000 rpm). This grid is evenly spaced in N instead, so every
 //! lobe gets the same number of points.
 
-use crate::boundary::dominant_mode_frequency_hz;
+use crate::boundary::{LobePoint, dominant_mode_frequency_hz};
 use chatter_dynamics::ModalModel;
+use chatter_dynamics::grid::evenly_spaced;
 
 /// Speeds per unit lobe number of [`lobe_speeds_rpm`].
 pub const POINTS_PER_LOBE: f64 = 20.0;
@@ -47,20 +49,42 @@ pub fn default_speeds_rpm(model: &ModalModel) -> Vec<f64> {
     )
 }
 
-/// `n >= 2` evenly spaced values from `min` to `max` inclusive.
-pub(crate) fn evenly_spaced(min: f64, max: f64, n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| min + (max - min) * i as f64 / (n - 1) as f64)
-        .collect()
-}
-
 /// `count` depths from 1 / `count` to [`DEPTH_GRID_TOP`] times `deepest` (in the unit of
 /// `deepest`): the default depth grid of maps and bands over lobes whose deepest finite limit
-/// is `deepest`.
+/// is `deepest` ([`deepest_limit_m`]).
 pub fn depth_grid(deepest: f64, count: usize) -> Vec<f64> {
-    (1..=count)
-        .map(|j| DEPTH_GRID_TOP * deepest * j as f64 / count as f64)
-        .collect()
+    depth_grid_to(DEPTH_GRID_TOP * deepest, count)
+}
+
+/// `count` depths `top` j / `count`, j = 1..=`count` (in the unit of `top`): zero left out, the
+/// top included. The one depth-grid rule of the workspace; [`depth_grid`] is its default top.
+pub fn depth_grid_to(top: f64, count: usize) -> Vec<f64> {
+    (1..=count).map(|j| top * j as f64 / count as f64).collect()
+}
+
+/// The deepest finite limiting depth (m) of `lobes`; `None` when no speed has a limit below
+/// the depth ceiling.
+pub fn deepest_limit_m(lobes: &[LobePoint]) -> Option<f64> {
+    let deepest = lobes
+        .iter()
+        .map(|p| p.depth_m)
+        .filter(|d| d.is_finite())
+        .fold(0.0, f64::max);
+    (deepest > 0.0).then_some(deepest)
+}
+
+/// Depths (mm) from half the lowest to 1.4 times the highest finite limit of `lobes`,
+/// `step_mm` apart: the contours around every lobe, its top included, lie on the grid (the
+/// credibility bounds of `chatter demo`). `None` when no speed has a finite limit.
+pub fn covering_depths_mm(lobes: &[LobePoint], step_mm: f64) -> Option<Vec<f64>> {
+    let finite = lobes.iter().map(|p| p.depth_mm()).filter(|d| d.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(d), b.max(d)));
+    if !(lo.is_finite() && hi > 0.0) {
+        return None;
+    }
+    let (from, to) = (0.5 * lo, 1.4 * hi);
+    let n = ((to - from) / step_mm).ceil() as usize;
+    Some((0..=n).map(|j| from + step_mm * j as f64).collect())
 }
 
 /// Speeds over [`lobe_range_rpm`] of the dominant mode f_d ([`dominant_mode_frequency_hz`]),

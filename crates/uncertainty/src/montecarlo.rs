@@ -9,16 +9,18 @@
 //! [`SampleFailure`] and reported, never read as stable; one failure does not stop the map.
 
 use crate::error::{Result, UncertaintyError};
+use chatter_bayes::Prior;
+use chatter_bayes::prior::MultivariateNormalPrior;
 pub use chatter_updating::sampled::{
     FailureKind, QuantileBand, SampleFailure, SampledBoundaries, StabilityMap, quantile,
     sample_boundaries,
 };
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use rand::SeedableRng;
-use rand_distr::{Distribution, StandardNormal};
 
 /// One draw per sample of theta ~ N(`mean`, `covariance`), seeded: theta = mean + L z with L the
-/// Cholesky factor of the covariance and z standard normal. The draws do not depend on threads.
+/// Cholesky factor of the covariance and z standard normal
+/// ([`chatter_bayes::prior::MultivariateNormalPrior`]'s draw). The draws do not depend on threads.
 pub fn gaussian_draws(
     mean: &[f64],
     covariance: &DMatrix<f64>,
@@ -36,20 +38,17 @@ pub fn gaussian_draws(
             ),
         });
     }
-    let l = covariance
-        .clone()
-        .cholesky()
-        .ok_or_else(|| UncertaintyError::InvalidInput {
+    let rows: Vec<Vec<f64>> = covariance
+        .row_iter()
+        .map(|r| r.iter().copied().collect())
+        .collect();
+    // the one multivariate-normal draw of the workspace: mean + L z, z ~ N(0, I)
+    let normal = MultivariateNormalPrior::new(mean.to_vec(), &rows).map_err(|e| {
+        UncertaintyError::InvalidInput {
             field: "covariance",
-            message: "not symmetric positive definite".into(),
-        })?
-        .l();
+            message: e.to_string(),
+        }
+    })?;
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    Ok((0..samples)
-        .map(|_| {
-            let z = DVector::from_fn(d, |_, _| StandardNormal.sample(&mut rng));
-            let t = &l * z;
-            mean.iter().zip(t.iter()).map(|(m, t)| m + t).collect()
-        })
-        .collect())
+    Ok((0..samples).map(|_| normal.sample(&mut rng)).collect())
 }

@@ -131,9 +131,7 @@ pub struct PlanOutcome {
 /// its top instead of a tenth) and 60 depths up to twice the deepest nominal limit there.
 fn grid_default(model: &ModalModel, observations: &Observations) -> Result<(Vec<f64>, Vec<f64>)> {
     let cuts = &observations.cuts;
-    let spread = |lo: f64, hi: f64| -> Vec<f64> {
-        (0..41).map(|i| lo + (hi - lo) * i as f64 / 40.0).collect()
-    };
+    let spread = |lo: f64, hi: f64| chatter_dynamics::grid::evenly_spaced(lo, hi, 41);
     if cuts.is_empty() {
         let range = chatter_stability::speed_grid::lobe_speeds_rpm(model);
         let hi = range.last().copied().unwrap_or(1000.0);
@@ -146,20 +144,15 @@ fn grid_default(model: &ModalModel, observations: &Observations) -> Result<(Vec<
         let nominal = SolverOptions::default()
             .prepare_on_grid_of(model, model)?
             .limiting_depths(&speeds)?;
-        let deepest = nominal
-            .iter()
-            .map(|p| p.depth_m)
-            .filter(|d| d.is_finite())
-            .fold(0.0, f64::max);
-        if deepest <= 0.0 {
+        let Some(deepest) = chatter_stability::speed_grid::deepest_limit_m(&nominal) else {
             return Err(UpdatingError::InvalidInput {
                 field: "depths",
                 message: "the nominal model is stable at every candidate speed up to the depth \
                           ceiling; give the speeds and depths"
                     .into(),
             });
-        }
-        let depths = (1..=60).map(|i| 2.0 * deepest * i as f64 / 60.0).collect();
+        };
+        let depths = chatter_stability::speed_grid::depth_grid_to(2.0 * deepest, 60);
         return Ok((speeds, depths));
     }
     let lo = cuts
@@ -169,7 +162,7 @@ fn grid_default(model: &ModalModel, observations: &Observations) -> Result<(Vec<
         * 0.75;
     let hi = cuts.iter().map(|c| c.speed_rpm).fold(0.0, f64::max) * 1.25;
     let deepest = cuts.iter().map(|c| c.depth_mm).fold(0.0, f64::max) * 1e-3;
-    let depths = (1..=60).map(|i| 2.0 * deepest * i as f64 / 60.0).collect();
+    let depths = chatter_stability::speed_grid::depth_grid_to(2.0 * deepest, 60);
     Ok((spread(lo, hi), depths))
 }
 

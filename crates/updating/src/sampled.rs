@@ -261,17 +261,7 @@ impl SampledBoundaries {
     }
 }
 
-/// Linear-interpolated quantile (type 7) of finite values; NaN when there are none.
-pub fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
-    values.retain(|v| v.is_finite());
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    let h = (values.len() - 1) as f64 * q.clamp(0.0, 1.0);
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    values[lo] + (h - lo as f64) * (values[hi] - values[lo])
-}
+pub use chatter_bayes::special::quantile;
 
 /// The boundary of one sampled model at `speeds_rpm` by the prepared method of `options`:
 /// `Err` when the method cannot be prepared for the model, otherwise one result per speed.

@@ -27,21 +27,32 @@ def validate(model: Source, observations: Optional[Source] = None) -> dict:
 
 def lobes(model: Source, speeds_rpm: Optional[Array] = None, method: str = "fdm") -> dict:
     """Limiting depth per speed: ``speed_rpm`` (rpm), ``depth_mm`` (mm), ``chatter_hz`` (Hz).
-    ``method``: "zoa", "fdm" or "sdm"; default speeds around the dominant mode's lobes."""
+    ``method``: "zoa", "fdm" or "sdm"; default speeds those of ``chatter lobes``: the dominant
+    mode's lobes, evenly spaced in lobe number (20 speeds per lobe, 200-2000 speeds)."""
 
-def multiplier(model: Source, speed_rpm: float, depth_mm: float, method: str = "fdm") -> dict:
-    """Dominant Floquet multiplier: ``modulus``, ``real``, ``imag``, ``frequency_hz`` (principal),
-    ``chatter_hz``, ``kind`` (hopf/flip/fold), ``stable``."""
+def multiplier(
+    model: Source,
+    speed_rpm: float,
+    depth_mm: float,
+    method: str = "fdm",
+    ssv_amplitude_ratio: Optional[float] = None,
+    ssv_frequency_ratio: Optional[float] = None,
+) -> dict:
+    """Dominant Floquet multiplier: ``method``, ``modulus``, ``real``, ``imag``, ``stable`` and
+    at constant speed ``frequency_hz`` (principal), ``chatter_hz``, ``kind`` (hopf/flip/fold);
+    with a sinusoidal speed variation (both ratios) ``ssv_amplitude_ratio``,
+    ``ssv_frequency_ratio`` and ``period_s`` (the multiplier over the variation's period)."""
 
 def bands_geometric(
     model: Source,
     speeds_rpm: Optional[Array] = None,
-    offset_rpm: float = 100.0,
-    offset_mm: float = 0.2,
+    offset_rpm: Optional[float] = None,
+    offset_mm: Optional[float] = None,
     method: str = "zoa",
 ) -> dict:
     """Type B offsets (Schmitz 2023): ``speed_rpm``, ``depth_mm``, ``lower_mm``, ``upper_mm``
-    (NaN where not covered), ``theta_deg`` (Eq. 2), ``distance`` (Eq. 1, rpm/um units)."""
+    (NaN where not covered), ``theta_deg`` (Eq. 2), ``distance`` (Eq. 1, rpm/um units).
+    Offsets default to the request's 100 rpm and 0.2 mm (seed 001)."""
 
 def bands_perturbation(
     model: Source,
@@ -59,8 +70,8 @@ def bands_montecarlo(
     model: Source,
     distribution: Distribution,
     speeds_rpm: Optional[Array] = None,
-    samples: int = 500,
-    seed: int = 0,
+    samples: Optional[int] = None,
+    seed: Optional[int] = None,
     method: str = "fdm",
     map_depths_mm: Optional[Array] = None,
 ) -> dict:
@@ -211,7 +222,9 @@ def campaign_table(lines: list[str]) -> str:
     """The batch table of table lines (header first)."""
 
 def synthetic_campaign(
-    effect: str, magnitude: float, seed: int, cuts: int = 32, pole_speeds: int = 4
+    effect: str, magnitude: float, seed: int, cuts: int = 32, pole_speeds: Optional[int] = None
 ) -> tuple[dict, dict]:
     """A synthetic milling campaign (model dict, observations dict) with a hidden ``effect``
-    ("none", "parameter_error", "process_damping", ...) at ``magnitude``."""
+    ("none", "parameter_error", "process_damping", ...) at ``magnitude``; poles at
+    ``pole_speeds`` speeds spread over the range (None: 3000, 6000, 9000, 12 000 rpm, as in
+    ``chatter demo``)."""

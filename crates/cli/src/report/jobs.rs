@@ -9,11 +9,11 @@ use crate::plot::Series;
 use anyhow::Result;
 use chatter_dynamics::{ModalModel, Observations};
 use chatter_gap::{Diagnosis, EffectClass, Verdict};
+use chatter_jobs::bands::BandCurves;
 use chatter_jobs::diagnose::RecordedDiagnosis;
 use chatter_jobs::recordings::{RecordVerdict, row_file_name};
 use chatter_updating::plan::PlanOutcome;
 use chatter_updating::update::UpdateResult;
-use std::collections::HashMap;
 
 /// "N cuts, M poles, K signals" of an observations file.
 fn observation_counts(o: &Observations) -> String {
@@ -205,23 +205,6 @@ pub fn update(
     Ok(page)
 }
 
-/// The columns of a CSV text by header name; empty or unreadable cells are NaN.
-fn columns(csv: &str) -> HashMap<String, Vec<f64>> {
-    let mut lines = csv.lines();
-    let header: Vec<String> = lines
-        .next()
-        .map(|h| h.split(',').map(str::to_string).collect())
-        .unwrap_or_default();
-    let mut out: HashMap<String, Vec<f64>> = header.iter().map(|h| (h.clone(), vec![])).collect();
-    for line in lines {
-        for (name, cell) in header.iter().zip(line.split(',')) {
-            let v = cell.trim().parse::<f64>().unwrap_or(f64::NAN);
-            out.entry(name.clone()).or_default().push(v);
-        }
-    }
-    out
-}
-
 /// The lowest and the highest finite value of `ys` with its `xs`.
 fn extremes(xs: &[f64], ys: &[f64]) -> Option<((f64, f64), (f64, f64))> {
     let pts: Vec<(f64, f64)> = xs
@@ -235,14 +218,17 @@ fn extremes(xs: &[f64], ys: &[f64]) -> Option<((f64, f64), (f64, f64))> {
     Some((low, high))
 }
 
-/// What a band (or lobe) CSV says: its verdict, a summary table and the rows without a
-/// boundary (a warning that gives `why_missing`). `csv` has `speed_rpm` and `depth_mm` (the
-/// boundary) and may have `lower_mm` (the conservative curve, called `lower_label`) and
-/// `upper_mm`.
-pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str, why_missing: &str) {
-    let c = columns(csv);
-    let empty = Vec::new();
-    let speeds = c.get("speed_rpm").unwrap_or(&empty);
+/// What a band (or lobe) outcome says: its verdict, a summary table and the speeds without a
+/// boundary (a warning that gives `why_missing`). `c` has the boundary and may have the
+/// conservative curve (called `lower_label`) and the upper one.
+pub fn band_findings(
+    page: &mut Page,
+    what: &str,
+    c: &BandCurves,
+    lower_label: &str,
+    why_missing: &str,
+) {
+    let speeds = &c.speed_rpm;
     let mut table = Table::new(
         &format!("{what}: summary"),
         &[
@@ -255,11 +241,11 @@ pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str, 
         ],
     );
     for (column, label) in [
-        ("depth_mm", "boundary"),
-        ("lower_mm", lower_label),
-        ("upper_mm", "upper curve"),
+        (Some(&c.depth_mm), "boundary"),
+        (c.lower_mm.as_ref(), lower_label),
+        (c.upper_mm.as_ref(), "upper curve"),
     ] {
-        let Some(ys) = c.get(column) else { continue };
+        let Some(ys) = column else { continue };
         let finite = ys.iter().filter(|y| y.is_finite()).count();
         let (low, high) =
             extremes(speeds, ys).unwrap_or(((f64::NAN, f64::NAN), (f64::NAN, f64::NAN)));
@@ -279,8 +265,7 @@ pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str, 
             ));
         }
     }
-    let depth = c.get("depth_mm").unwrap_or(&empty);
-    if let Some(((s_low, d_low), (s_high, d_high))) = extremes(speeds, depth) {
+    if let Some(((s_low, d_low), (s_high, d_high))) = extremes(speeds, &c.depth_mm) {
         let mut text = format!(
             "{what}: the deepest stable pocket reaches {} mm at {} rpm; the boundary's lowest \
              point is {} mm at {} rpm.",
@@ -289,7 +274,7 @@ pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str, 
             number(d_low),
             number(s_low)
         );
-        if let Some(lower) = c.get("lower_mm") {
+        if let Some(lower) = &c.lower_mm {
             let at_pocket = speeds
                 .iter()
                 .zip(lower)
@@ -323,6 +308,10 @@ pub fn band_findings(page: &mut Page, what: &str, csv: &str, lower_label: &str, 
     page.table(table);
 }
 
+/// Title of the demo's credibility plot (and its caption in the report page).
+pub const CREDIBILITY_TITLE: &str = "Turning tool of Ahmadi (2022) after updating: limit at the \
+     posterior mean, bounds where the dominant multiplier's mean modulus +- 1 sd reaches 1";
+
 /// Why a lobe diagram has no boundary at a speed.
 pub const LOBES_MISSING: &str = "no lobe there: every depth is stable at that speed";
 /// Why a perturbation band has no boundary at a speed.
@@ -347,7 +336,9 @@ pub struct BandsResult<'a> {
     pub model: &'a ModalModel,
     /// The observed cuts, when given.
     pub observations: Option<&'a Observations>,
-    /// The CSV the command wrote.
+    /// The outcome's curves per speed.
+    pub curves: &'a BandCurves,
+    /// The CSV the command wrote (shown as a table).
     pub csv: &'a str,
     /// The plots (caption, SVG).
     pub figures: Vec<(String, String)>,
@@ -365,7 +356,7 @@ pub fn bands(r: &BandsResult) -> Result<Page> {
     for w in &r.warnings {
         page.warning(w.clone());
     }
-    band_findings(&mut page, "Bands", r.csv, r.lower_label, r.why_missing);
+    band_findings(&mut page, "Bands", r.curves, r.lower_label, r.why_missing);
     page.table(Table::from_csv("Every speed (the CSV)", r.csv));
     for (caption, svg) in &r.figures {
         page.figure(caption, svg)?;
@@ -717,7 +708,7 @@ fn caption_of(name: &str) -> Option<&'static str> {
              disagree with the nominal model"
         }
         "turning_lobes.svg" => "Turning tool of Ahmadi (2022): FDM lobes and the test cuts",
-        "turning_credibility.svg" => crate::commands::CREDIBILITY_TITLE,
+        "turning_credibility.svg" => CREDIBILITY_TITLE,
         "milling_bands.svg" => {
             "Milling example of Schmitz (2023): zero-order lobes offset by 100 rpm and 0.2 mm"
         }
@@ -768,7 +759,7 @@ pub fn plan_plot(
         "spindle speed (rpm)",
         "depth (mm)",
         &series,
-        crate::commands::markers(Some(observations)).as_ref(),
+        crate::tables::markers(Some(observations)).as_ref(),
     )
     .map_err(|e| e.to_string())
 }
@@ -880,9 +871,18 @@ pub fn plan(
     Ok(page)
 }
 
-/// The page of `chatter demo`, from the files of its folder (before the commit), the models it
-/// ran and the diagnosis.
-pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> Result<Page> {
+/// A band result of the demo for its findings: what it is, its curves, the name of its
+/// conservative curve and why a speed may have no boundary.
+pub type DemoBands<'a> = (&'a str, BandCurves, &'a str, &'a str);
+
+/// The page of `chatter demo`, from the files of its folder (before the commit), its band
+/// results, the models it ran and the diagnosis.
+pub fn demo(
+    folder: &Folder,
+    bands: &[DemoBands],
+    models: &[(&str, &ModalModel)],
+    d: &Diagnosis,
+) -> Result<Page> {
     let mut page = Page::new("chatter demo: the main job on the embedded examples");
     page.command_line_inputs();
     page.input(
@@ -900,27 +900,9 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
             .map(|b| String::from_utf8_lossy(b).into_owned())
             .unwrap_or_default()
     };
-    band_findings(
-        &mut page,
-        "Turning tool of Ahmadi (2022) (FDM lobes)",
-        &text("turning_lobes.csv"),
-        "",
-        LOBES_MISSING,
-    );
-    band_findings(
-        &mut page,
-        "Turning tool of Ahmadi (2022) after updating (credibility bounds)",
-        &text("turning_credibility.csv"),
-        "lower credibility bound",
-        PERTURBATION_MISSING,
-    );
-    band_findings(
-        &mut page,
-        "Milling example of Schmitz (2023) (offsets 100 rpm, 0.2 mm)",
-        &text("milling_bands.csv"),
-        "lower offset boundary",
-        GEOMETRIC_MISSING,
-    );
+    for (what, curves, lower_label, why_missing) in bands {
+        band_findings(&mut page, what, curves, lower_label, why_missing);
+    }
     diagnosis_findings(&mut page, d);
     for (name, caption) in [
         ("turning_lobes.csv", "Turning lobes (the CSV)"),
@@ -952,13 +934,18 @@ pub fn demo(folder: &Folder, models: &[(&str, &ModalModel)], d: &Diagnosis) -> R
 #[cfg(test)]
 mod tests {
     use super::*;
+    use chatter_stability::boundary::LobePoint;
 
     #[test]
     fn band_findings_name_the_pocket_the_safe_depth_and_the_missing_rows() {
-        let csv = "speed_rpm,depth_mm,lower_mm,upper_mm\n\
-                   1000,1,0.5,1.5\n2000,3,2,\n3000,2,1.5,2.5\n";
+        let curves = BandCurves {
+            speed_rpm: vec![1000.0, 2000.0, 3000.0],
+            depth_mm: vec![1.0, 3.0, 2.0],
+            lower_mm: Some(vec![0.5, 2.0, 1.5]),
+            upper_mm: Some(vec![1.5, f64::NAN, 2.5]),
+        };
         let mut page = Page::new("t");
-        band_findings(&mut page, "Bands", csv, "lower bound", "why");
+        band_findings(&mut page, "Bands", &curves, "lower bound", "why");
         let html = page.html();
         assert!(
             html.contains("the deepest stable pocket reaches 3 mm at 2000 rpm"),
@@ -977,12 +964,17 @@ mod tests {
     }
 
     #[test]
-    fn a_csv_without_a_finite_boundary_says_so() {
+    fn lobes_without_a_finite_boundary_say_so() {
         let mut page = Page::new("t");
+        let lobes = [LobePoint {
+            speed_rpm: 1000.0,
+            depth_m: f64::INFINITY,
+            chatter_hz: f64::NAN,
+        }];
         band_findings(
             &mut page,
             "Lobes",
-            "speed_rpm,depth_mm\n1000,inf\n",
+            &BandCurves::of_lobes(&lobes),
             "",
             LOBES_MISSING,
         );
