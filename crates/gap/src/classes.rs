@@ -44,13 +44,11 @@ const PROCESS_DAMPING_SPAN: f64 = 3.0;
 /// low-immersion machines (1x, 2x) the verdict was right on 4 of 4 with four slices of 120 and
 /// two or three steps ([`EffectClass::steps`]), on 1 of 4 with one population of 300 samples,
 /// 2 of 4 with four slices and one step, 3 of 4 with four slices of 100 and two steps, 3 of 4
-/// with two slices of 300, 2 of 3 with one population of 180 and three steps. Each slice now
-/// draws half the class budget ([`EffectClass::samples`]); on the outside generator's 20
-/// campaigns the verdicts were unchanged by it except that of drift 1x on the low-immersion
-/// machine, wrong both ways (`extra_mode` with the full budget, `parameter_error` with half).
+/// with two slices of 300, 2 of 3 with one population of 180 and three steps. Half the samples
+/// per slice (60) would save a third of a campaign's time but lost the extra mode at 2x on the
+/// xy and low-immersion machines of the proving ground (xy: ln Z -236 against -110 with 120;
+/// the verdict `unexplained`).
 const EXTRA_MODE_STRATA: usize = 4;
-/// Fewest samples of one stratum of [`EffectClass::samples`].
-const MIN_STRATUM_SAMPLES: usize = 40;
 /// Gap along a stratified coordinate (ln of the extra mode's frequency: 5 %) that separates two
 /// posterior modes in [`ClassModel::posterior_mean`]; a polished mode of the proving ground
 /// spreads its samples over a few per cent with gaps of a few tenths of a per cent.
@@ -172,18 +170,6 @@ impl EffectClass {
         match self {
             EffectClass::ExtraMode => 2 * steps,
             _ => steps,
-        }
-    }
-
-    /// iTMCMC samples per stratum for this class, from the options' `samples` per class.
-    /// `extra_mode` draws half as many in each of its [`EXTRA_MODE_STRATA`] strata (twice the
-    /// other classes' in all): with the full number per stratum and twice the steps it took 8x
-    /// the likelihood evaluations of a class without strata, two thirds of a campaign's time
-    /// (public_01: 67 of 99 s).
-    pub fn samples(self, samples: usize) -> usize {
-        match self {
-            EffectClass::ExtraMode => (samples / 2).max(MIN_STRATUM_SAMPLES),
-            _ => samples,
         }
     }
 

@@ -35,8 +35,7 @@ pub(crate) const PREDICTIVE_SAMPLES: usize = 100;
 pub struct DiagnoseOptions {
     /// Seed of every random choice (samplers, folds, replications).
     pub seed: u64,
-    /// iTMCMC samples per class (per stratum for a class with [`EffectClass::strata`], as
-    /// [`EffectClass::samples`] sets them).
+    /// iTMCMC samples per class (per stratum for a class with [`EffectClass::strata`]).
     pub samples: usize,
     /// Metropolis-Hastings steps per chain and stage.
     pub steps: usize,
@@ -376,7 +375,7 @@ pub(crate) fn fit<'a>(
     let like = |theta: &[f64]| log_likelihood(&model, data, &options.noise, theta, &count);
     let tmcmc_options = TmcmcOptions {
         steps: class.steps(options.steps),
-        ..options.tmcmc(class.samples(samples), seed)
+        ..options.tmcmc(samples, seed)
     };
     let run = match class.strata() {
         None => tmcmc(&model.prior, &like, &tmcmc_options, observer),
