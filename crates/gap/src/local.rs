@@ -13,17 +13,17 @@
 //!   one, so each cut's log-depth distance d = ln(b / b_lim) becomes d + delta (a regional error
 //!   of the cutting coefficient, the damping or the stiffness moves the limit so). The band's
 //!   label statistic is max over delta of sum [ln p(y_i | d_i + delta) - ln p(y_i | d_i)], delta
-//!   on a grid of +-[`DELTA_GRID`] (0 included, so it is >= 0); p is the likelihood's probit
+//!   on a grid of +-`DELTA_GRID` (0 included, so it is >= 0); p is the likelihood's probit
 //!   with its lapse, so one mislabel gains at most ln(1 / lapse).
 //! - Chatter frequencies, pole frequencies and pole damping ratios: their standardized
-//!   residuals z_i, each clipped to +-sqrt([`OUTLIER_CAP`]) as the global check caps them, are
+//!   residuals z_i, each clipped to +-sqrt(`OUTLIER_CAP`) as the global check caps them, are
 //!   off by a common mean in the band; each kind adds its Gaussian likelihood ratio
 //!   (sum z_i)^2 / (2 n).
 //! - Every run of consecutive speeds holding at least [`MIN_BAND`] observations and at most half
 //!   of them is a band; the statistic is the largest band's likelihood ratio. Its p-value is the
 //!   share of replicated campaigns (labels drawn from each cut's chatter probability, residuals
 //!   from N(0, 1) and clipped, the same items) whose largest band statistic is at least as large,
-//!   pooled over the posterior samples ([`REPLICATES`] in all, enough to resolve the Bonferroni
+//!   pooled over the posterior samples (`REPLICATES` in all, enough to resolve the Bonferroni
 //!   level of the check).
 //!
 //! The band of the largest statistic is reported, so an `unexplained` verdict names where the
