@@ -632,13 +632,16 @@ pub fn diagnose(
     };
     let polish_seed = class_seed(options.seed, fitted[best].model.class, usize::MAX);
     polish(&mut fitted[best], &data, &options, polish_seed, observer)?;
-    let mut check = predictive_check(
-        &posterior_predictions(&fitted[best], &data),
-        &data,
-        &options.noise,
-        options.check_level,
-        options.seed,
-    );
+    let checked = |f: &Fitted| {
+        predictive_check(
+            &posterior_predictions(f, &data),
+            &data,
+            &options.noise,
+            options.check_level,
+            options.seed,
+        )
+    };
+    let mut check = checked(&fitted[best]);
     // a failed check must be the class's, not an unconverged population's: twice the rounds
     // once more before the class is given up
     if !check.passed && options.polish_rounds > 0 {
@@ -647,13 +650,7 @@ pub fn diagnose(
             ..options.clone()
         };
         polish(&mut fitted[best], &data, &again, polish_seed ^ 1, observer)?;
-        check = predictive_check(
-            &posterior_predictions(&fitted[best], &data),
-            &data,
-            &options.noise,
-            options.check_level,
-            options.seed,
-        );
+        check = checked(&fitted[best]);
     }
     let best_class = fitted[best].model.class;
     // the nominal model is a class without parameters: its evidence is its likelihood
@@ -682,9 +679,14 @@ pub fn diagnose(
         &options.noise,
     );
     let log_bayes_factor = alternative_log_evidence - nominal_log_evidence;
-    let consistent = nominal_check.passed
-        && (log_bayes_factor < options.min_log_bayes_factor_against_nominal
-            || practical_shift < options.equivalence_std);
+    let rule = Rule {
+        noise: &options.noise,
+        check_level: options.check_level,
+        seed: options.seed,
+        min_log_bayes_factor: options.min_log_bayes_factor_against_nominal,
+        equivalence_std: options.equivalence_std,
+    };
+    let consistent = rule.consistent(nominal_check.passed, log_bayes_factor, practical_shift);
     // a rejection that one observation carries alone is not one
     let lone = if consistent {
         None
@@ -694,13 +696,7 @@ pub fn diagnose(
             (&candidate, &candidate_prediction),
             &data,
             log_bayes_factor,
-            &Rule {
-                noise: &options.noise,
-                check_level: options.check_level,
-                seed: options.seed,
-                min_log_bayes_factor: options.min_log_bayes_factor_against_nominal,
-                equivalence_std: options.equivalence_std,
-            },
+            &rule,
         )
     };
     if let Some(lone) = lone {

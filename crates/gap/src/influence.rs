@@ -66,6 +66,15 @@ pub(crate) struct Rule<'a> {
     pub equivalence_std: f64,
 }
 
+impl Rule<'_> {
+    /// The `consistent` rule: the nominal model passes its check and either the alternative does
+    /// not beat it by the Bayes factor or no prediction moves by more than the equivalence.
+    pub fn consistent(&self, check_passed: bool, log_bayes_factor: f64, shift: f64) -> bool {
+        check_passed
+            && (log_bayes_factor < self.min_log_bayes_factor || shift < self.equivalence_std)
+    }
+}
+
 /// The observation the rejection of the nominal model rests on, if it rests on one (module
 /// docs): `log_bayes_factor` is the alternative's over the nominal model on all of `data`.
 pub(crate) fn lone_observation(
@@ -102,25 +111,24 @@ pub(crate) fn lone_observation(
         rule.check_level,
         rule.seed,
     );
-    let consistent = check.passed
-        && (log_bayes_factor - gain < rule.min_log_bayes_factor
-            || largest_shift(&p0, &p1, &rest, rule.noise) < rule.equivalence_std);
-    consistent.then(|| {
-        let (index, speed_rpm, depth_m) = if pole {
-            let p = &data.poles[at];
-            (p.index, p.speed_rpm, p.depth_m)
-        } else {
-            let c = &data.cuts[at];
-            (c.index, c.speed_rpm, c.depth_m)
-        };
-        LoneObservation {
-            pole,
-            index,
-            speed_rpm,
-            depth_mm: depth_m * 1e3,
-            gain,
-        }
-    })
+    let shift = largest_shift(&p0, &p1, &rest, rule.noise);
+    rule.consistent(check.passed, log_bayes_factor - gain, shift)
+        .then(|| {
+            let (index, speed_rpm, depth_m) = if pole {
+                let p = &data.poles[at];
+                (p.index, p.speed_rpm, p.depth_m)
+            } else {
+                let c = &data.cuts[at];
+                (c.index, c.speed_rpm, c.depth_m)
+            };
+            LoneObservation {
+                pole,
+                index,
+                speed_rpm,
+                depth_mm: depth_m * 1e3,
+                gain,
+            }
+        })
 }
 
 #[cfg(test)]
