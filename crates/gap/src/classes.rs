@@ -22,10 +22,21 @@
 //!
 //! f_ref and k_ref are the frequency and modal stiffness of the nominal mode that dominates
 //! regenerative chatter.
+//!
+//! Besides the listed classes, the open alternative `speed_band` ([`EffectClass::SpeedBand`])
+//! asks whether the gap is confined to one region of speeds, in a shape none of the listed
+//! effects has: the cutting coefficients over the stiffness times exp(a exp(-x^2 / 2w^2)),
+//! x = ln(Omega / Omega_c) ([`crate::variant::CuttingBump`]), with a ~ N(0, 0.7^2) (a factor
+//! within 1/4 to 4 at two standard deviations), the centre's position in the observed range of
+//! ln speed ~ U(-0.1, 1.1) (just beyond either end: a trend toward that end) and ln w ~
+//! U(ln 0.02, ln 0.5) (a band of +-2 % to a trend over a factor 1.6 in speed). A band of
+//! changed cutting coefficients or damping, or cutting coefficients that rise toward low
+//! cutting speed (built-up edge), all look like this to the labels. It is never a verdict: when
+//! it wins ([`crate::diagnose`]), the verdict is `unexplained` with the band named.
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};
-use crate::variant::{Variant, recalibrated_per_mode};
+use crate::variant::{CuttingBump, Variant, recalibrated_per_mode};
 use chatter_bayes::prior::{IndependentPrior, Marginal, Prior};
 use chatter_dynamics::{ModalModel, Mode, ModeShape};
 use chatter_stability::boundary::BoundaryOptions;
@@ -92,6 +103,13 @@ mod slot {
     pub const EXTRA_STIFFNESS: usize = 5;
     /// `extra_mode`: the direction's angle from x (rad, an axis: period pi).
     pub const EXTRA_DIRECTION: usize = 6;
+    /// `speed_band`: a, the log of the factor at the band's centre.
+    pub const BAND_LN_FACTOR: usize = 3;
+    /// `speed_band`: the centre's position in the observed range of ln speed (0 lowest, 1
+    /// highest).
+    pub const BAND_CENTER: usize = 4;
+    /// `speed_band`: ln w, w the half-width in ln speed.
+    pub const BAND_LN_WIDTH: usize = 5;
 }
 
 /// The extra mode of `extra_mode` at parameters theta, in physical units.
@@ -142,6 +160,9 @@ pub enum EffectClass {
     ExtraMode,
     /// Recalibration plus cutting coefficients changing linearly with `sequence`.
     Drift,
+    /// The open alternative (module docs): recalibration plus cutting coefficients changed in
+    /// one band of speeds. Never named as the verdict.
+    SpeedBand,
 }
 
 impl EffectClass {
@@ -168,7 +189,7 @@ impl EffectClass {
     /// test campaigns, and pushed a 40-cut turning campaign from 60 s towards 80 s.
     pub fn steps(self, steps: usize) -> usize {
         match self {
-            EffectClass::ExtraMode => 2 * steps,
+            EffectClass::ExtraMode | EffectClass::SpeedBand => 2 * steps,
             _ => steps,
         }
     }
@@ -190,6 +211,23 @@ impl EffectClass {
             EffectClass::SpeedDependentDynamics => "speed_dependent_dynamics",
             EffectClass::ExtraMode => "extra_mode",
             EffectClass::Drift => "drift",
+            EffectClass::SpeedBand => "speed_band",
+        }
+    }
+
+    /// Whether the class is one of the listed effects a verdict may name ([`EffectClass::ALL`]);
+    /// false for the open alternative.
+    pub fn is_listed(self) -> bool {
+        self != EffectClass::SpeedBand
+    }
+
+    /// The coordinate along which the posterior may have separate modes, which
+    /// [`ClassModel::posterior_mean`] keeps apart: the extra mode's frequency, the band's centre.
+    fn mode_coordinate(self) -> Option<usize> {
+        match self {
+            EffectClass::ExtraMode => Some(slot::EXTRA_FREQUENCY),
+            EffectClass::SpeedBand => Some(slot::BAND_CENTER),
+            _ => None,
         }
     }
 }
@@ -222,6 +260,8 @@ pub(crate) struct Nominal {
     pub reference_stiffness_n_per_m: f64,
     /// Highest observed speed (rpm).
     pub max_speed_rpm: f64,
+    /// Lowest observed speed (rpm).
+    pub min_speed_rpm: f64,
     /// C_max of the process-damping prior; None without a cutting diameter.
     pub process_damping_scale_n_per_m: Option<f64>,
     /// The modes (indices into the model's) with their own frequency offset (module docs).
@@ -275,6 +315,7 @@ impl Nominal {
             reference_hz,
             reference_stiffness_n_per_m,
             max_speed_rpm,
+            min_speed_rpm,
             process_damping_scale_n_per_m,
             offset_modes,
         })
@@ -394,6 +435,17 @@ impl<'a> ClassModel<'a> {
                 low: -0.8,
                 high: 2.0,
             }),
+            EffectClass::SpeedBand => m.extend([
+                Marginal::Normal { mean: 0.0, sd: 0.7 },
+                Marginal::Uniform {
+                    low: -0.1,
+                    high: 1.1,
+                },
+                Marginal::Uniform {
+                    low: 0.02f64.ln(),
+                    high: 0.5f64.ln(),
+                },
+            ]),
         }
         m.extend(nominal.offset_modes.iter().map(|_| Marginal::Normal {
             mean: 0.0,
@@ -435,6 +487,7 @@ impl<'a> ClassModel<'a> {
                 v.model = v.model.with_modes(modes).ok()?;
             }
             EffectClass::Drift => v.drift_rate = theta[slot::EFFECT],
+            EffectClass::SpeedBand => v.cutting_bump = Some(self.bump(theta)),
         }
         Some(v)
     }
@@ -451,9 +504,9 @@ impl<'a> ClassModel<'a> {
             let density = |i: usize| ln_likelihoods[i] + self.prior.ln_pdf(&samples[i]);
             density(a).total_cmp(&density(b))
         })?;
-        let members: Vec<&Vec<f64>> = match self.class.strata() {
+        let members: Vec<&Vec<f64>> = match self.class.mode_coordinate() {
             None => samples.iter().collect(),
-            Some((coordinate, _)) => {
+            Some(coordinate) => {
                 let mut order: Vec<usize> = (0..samples.len()).collect();
                 order.sort_by(|&a, &b| samples[a][coordinate].total_cmp(&samples[b][coordinate]));
                 let at = order.iter().position(|&i| i == best)?;
@@ -508,6 +561,13 @@ impl<'a> ClassModel<'a> {
                 out.push(("direction_deg", extra.direction_rad.to_degrees()));
             }
             EffectClass::Drift => out.push(("cutting_change_over_campaign", theta[slot::EFFECT])),
+            EffectClass::SpeedBand => {
+                let b = self.bump(theta);
+                out.push(("band_cutting_factor", b.ln_factor.exp()));
+                out.push(("band_center_rpm", b.center_rpm));
+                out.push(("band_from_rpm", b.center_rpm * (-b.width_ln).exp()));
+                out.push(("band_to_rpm", b.center_rpm * b.width_ln.exp()));
+            }
         }
         let start = self.offsets_start();
         for (k, &j) in self.nominal.offset_modes.iter().enumerate() {
@@ -537,6 +597,19 @@ impl<'a> ClassModel<'a> {
     /// `process_damping`'s C (N/m) at theta.
     fn process_damping_n_per_m(&self, theta: &[f64]) -> f64 {
         theta[slot::EFFECT] * self.nominal.process_damping_scale_n_per_m.unwrap_or(0.0)
+    }
+
+    /// `speed_band`'s bump at theta.
+    pub(crate) fn bump(&self, theta: &[f64]) -> CuttingBump {
+        let (lo, hi) = (
+            self.nominal.min_speed_rpm.ln(),
+            self.nominal.max_speed_rpm.ln(),
+        );
+        CuttingBump {
+            center_rpm: (lo + theta[slot::BAND_CENTER] * (hi - lo)).exp(),
+            width_ln: theta[slot::BAND_LN_WIDTH].exp(),
+            ln_factor: theta[slot::BAND_LN_FACTOR],
+        }
     }
 
     /// `speed_dependent_dynamics`'s c in f_n(Omega) = f_n0 (1 - c Omega^2) at theta (1/rpm^2).

@@ -10,6 +10,7 @@ use crate::likelihood::{NoiseModel, terms};
 use crate::predict::{Prediction, predict};
 use crate::regions::{Region, RegionContext, Residuals, regions, residuals};
 use crate::shrink::{Shrink, ValidationReport, shrink};
+use crate::unlisted::{UnlistedBand, judge};
 use crate::variant::Variant;
 use chatter_bayes::Prior;
 use chatter_bayes::special::log_sum_exp;
@@ -70,6 +71,10 @@ pub struct DiagnoseOptions {
     pub validation_samples: usize,
     /// The candidate classes (`parameter_error` is always added).
     pub classes: Vec<EffectClass>,
+    /// Also fit the open alternative [`EffectClass::SpeedBand`] (a gap confined to a band of
+    /// speeds, [`crate::unlisted`]); when it wins, the verdict is `unexplained` with the band
+    /// named.
+    pub unlisted_band: bool,
     /// Also give every class's prior draws and pointwise log-likelihood
     /// ([`ClassPosterior::prior_draws`], [`ClassPosterior::log_likelihood`]) for ArviZ's LOO /
     /// WAIC: one more prediction per posterior sample.
@@ -106,6 +111,7 @@ impl Default for DiagnoseOptions {
             validation: Validation::KFold { folds: 3 },
             validation_samples: 80,
             classes: EffectClass::ALL.to_vec(),
+            unlisted_band: true,
             pointwise: false,
         }
     }
@@ -170,6 +176,7 @@ impl DiagnoseOptions {
         if !out.classes.contains(&EffectClass::ParameterError) {
             out.classes.insert(0, EffectClass::ParameterError);
         }
+        out.classes.retain(|c| c.is_listed());
         out.classes.sort();
         out.classes.dedup();
         Ok(out)
@@ -502,6 +509,9 @@ pub struct Diagnosis {
     pub residuals: ResidualPair,
     /// Why classes were left out, and what in the observations was not used.
     pub notes: Vec<String>,
+    /// The band of speeds the open alternative finds when it beats every listed explanation
+    /// ([`crate::unlisted`]); the verdict is then `unexplained`.
+    pub unlisted: Option<UnlistedBand>,
     /// ln p(D | nominal model): the likelihood of the nominal model, a class without free
     /// parameters.
     pub nominal_log_evidence: f64,
@@ -617,9 +627,25 @@ pub fn diagnose(
         observer.class_done(class.name(), f.run.log_evidence);
         fitted.push(f);
     }
+    // the listed classes first, the open alternative last
+    let listed = fitted.len();
+    if options.unlisted_band {
+        let class = EffectClass::SpeedBand;
+        let f = fit(
+            class,
+            &nominal,
+            &data,
+            &options,
+            options.samples,
+            class_seed(options.seed, class, 0),
+            observer,
+        )?;
+        observer.class_done(class.name(), f.run.log_evidence);
+        fitted.push(f);
+    }
     let evidences: Vec<f64> = fitted.iter().map(|f| f.run.log_evidence).collect();
     let probabilities = class_probabilities(&evidences);
-    let most_probable = (0..fitted.len())
+    let most_probable = (0..listed)
         .max_by(|&a, &b| evidences[a].total_cmp(&evidences[b]))
         .ok_or_else(|| GapError::Observations("no model class could be tried".into()))?;
     // an effect is named only when it beats plain recalibration decisively
@@ -667,7 +693,7 @@ pub fn diagnose(
     // the alternative "the nominal model is wrong in one of the tried ways" is the classes'
     // average evidence (equal prior probabilities): naming the best class after the fact would
     // pick the luckiest of several noisy evidences and raise false alarms
-    let alternative_log_evidence = log_sum_exp(&evidences) - (evidences.len() as f64).ln();
+    let alternative_log_evidence = log_sum_exp(&evidences[..listed]) - (listed as f64).ln();
     let candidate = fitted[best]
         .mean_variant()
         .unwrap_or_else(|| nominal_variant.clone());
@@ -703,7 +729,41 @@ pub fn diagnose(
         notes.push(lone.note());
     }
     let consistent = consistent || lone.is_some();
-    let verdict = if consistent {
+    // the open alternative against the best explanation from the list
+    let unlisted = fitted[listed..].first().and_then(|band| {
+        let mean = band
+            .model
+            .posterior_mean(band.run.samples.samples(), &band.run.ln_likelihoods)?;
+        let band_prediction = predict(&band.model.variant(&mean)?, &data);
+        let listed_best = if most_probable == best {
+            candidate_prediction.clone()
+        } else {
+            predict(&fitted[most_probable].mean_variant()?, &data)
+        };
+        let (reference, name) = if nominal_log_evidence >= evidences[most_probable] {
+            ((nominal_log_evidence, &nominal_prediction), "the nominal model")
+        } else {
+            (
+                (evidences[most_probable], &listed_best),
+                fitted[most_probable].model.class.name(),
+            )
+        };
+        judge(
+            (band.run.log_evidence, &band_prediction),
+            reference,
+            &band.model.physical(&mean),
+            &data,
+            &options.noise,
+            options.min_log_bayes_factor,
+        )
+        .map(|u| (u, name))
+    });
+    if let Some((u, name)) = &unlisted {
+        notes.push(u.note(name));
+    }
+    let verdict = if unlisted.is_some() {
+        Verdict::Unexplained
+    } else if consistent {
         Verdict::Consistent
     } else if check.passed {
         Verdict::Class(best_class)
@@ -711,6 +771,7 @@ pub fn diagnose(
         Verdict::Unexplained
     };
     if verdict == Verdict::Unexplained
+        && unlisted.is_none()
         && let (Some((from, to)), Some(local)) = (check.failing_band(), check.local)
     {
         notes.push(format!(
@@ -778,6 +839,7 @@ pub fn diagnose(
         validation,
         residuals: residual_pair,
         notes,
+        unlisted: unlisted.map(|(u, _)| u),
         nominal_log_evidence,
         alternative_log_evidence,
         nominal_check,

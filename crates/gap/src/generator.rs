@@ -518,7 +518,8 @@ pub fn true_variant(nominal: &ModalModel, scenario: &Scenario) -> Result<Variant
 /// damping 1x = C adding the structural damping of the dominant mode at the lowest speed and
 /// the lowest nominal limit; speed-dependent dynamics 1x = 4 % frequency drop at the top speed;
 /// extra mode 1x = a 45-degree mode at 1.35 f_ref, 3 %, 1.5 k_ref (2x: k / 2, 0.5x: k x 2);
-/// drift 1x = +40 % over the campaign.
+/// drift 1x = +40 % over the campaign; the open alternative `speed_band` 1x = cutting
+/// coefficients x2 between 0.4 and 0.7 of the speed range (an effect outside the list).
 pub fn effect_at(
     class: EffectClass,
     magnitude: f64,
@@ -583,6 +584,17 @@ pub fn effect_at(
             },
             none,
         ),
+        EffectClass::SpeedBand => {
+            let (lo, hi) = speed_range_rpm;
+            (
+                HiddenEffect::CuttingBand {
+                    from_rpm: lo + 0.4 * (hi - lo),
+                    to_rpm: lo + 0.7 * (hi - lo),
+                    factor: 1.0 + magnitude,
+                },
+                none,
+            )
+        }
     })
 }
 

@@ -34,7 +34,12 @@
 //! speeds ([`local`]); when that part fails, the `unexplained` verdict names the band. A
 //! rejection of the nominal model that one observation carries alone (without it the nominal
 //! model would be `consistent`) gives `consistent` with a note naming that observation
-//! (`influence`): one gross misidentification is not a model error.
+//! (`influence`): one gross misidentification is not a model error. Besides the listed classes
+//! the open alternative `speed_band` ([`unlisted`]: the cutting coefficients changed in one
+//! band of speeds, or a trend toward one end of the range) is fitted; when its evidence beats
+//! the nominal model's likelihood and every listed class's evidence by the Bayes factor an
+//! effect needs, also without the observation it helps most, the verdict is `unexplained` with
+//! the band named: a gap in a shape none of the listed effects has.
 //!
 //! # Outside proving ground
 //! Twenty campaigns of an outside generator (`../shared/data/gap_public`, its README; truth a
@@ -133,6 +138,7 @@ pub mod local;
 pub mod predict;
 pub mod regions;
 pub mod shrink;
+pub mod unlisted;
 pub mod variant;
 
 pub use check::PredictiveCheck;

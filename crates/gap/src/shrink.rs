@@ -18,7 +18,7 @@ use crate::diagnose::{DiagnoseOptions, Validation, class_seed, fit, posterior_pr
 use crate::error::Result;
 use crate::likelihood::{NoiseModel, terms};
 use crate::predict::{Prediction, predict};
-use crate::regions::residuals;
+use crate::regions::{residuals, rms};
 use chatter_bayes::special::log_mean_exp;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -144,10 +144,6 @@ impl Pool {
             (u, s) => Some(0.5 * (missed as f64 / u as f64 + false_alarms as f64 / s as f64)),
         }
     }
-}
-
-fn rms(v: &[f64]) -> Option<f64> {
-    (!v.is_empty()).then(|| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt())
 }
 
 /// The fold of every cut and every pole.

@@ -7,7 +7,9 @@
 //!   mass-normalized shape is unchanged, the stiffness falls with w_n^2);
 //! - drift, cutting coefficients x (1 + r u) with u in [0, 1] the campaign position;
 //! - a speed band where the cutting coefficients change by a factor (used only by the proving
-//!   ground, as an effect outside the candidate list).
+//!   ground, as an effect outside the candidate list);
+//! - a smooth bump of the cutting coefficients in log speed (the open alternative
+//!   [`crate::EffectClass::SpeedBand`]: a gap confined to one region of speeds).
 //!
 //! [`Variant::at`] applies them for one cut (radial immersion, speed, campaign position), so
 //! that any stability solver of `chatter-stability` evaluates the variant exactly.
@@ -30,6 +32,28 @@ pub struct CuttingBand {
     pub factor: f64,
 }
 
+/// Cutting coefficients multiplied by exp(a exp(-x^2 / 2w^2)), x = ln(Omega / Omega_c): a
+/// Gaussian bump of the log factor in log speed, peak factor e^a at the centre speed Omega_c,
+/// half-width w (a standard deviation in ln speed). A narrow bump is a band of speeds; one
+/// centred at or beyond an end of the observed range with a wide w is a trend toward that end.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CuttingBump {
+    /// Centre speed Omega_c (rpm).
+    pub center_rpm: f64,
+    /// Half-width w in ln speed.
+    pub width_ln: f64,
+    /// a: the log of the factor at the centre.
+    pub ln_factor: f64,
+}
+
+impl CuttingBump {
+    /// The factor on the cutting coefficients at `speed_rpm`.
+    pub fn factor(&self, speed_rpm: f64) -> f64 {
+        let x = (speed_rpm / self.center_rpm).ln() / self.width_ln;
+        (self.ln_factor * (-0.5 * x * x).exp()).exp()
+    }
+}
+
 /// A machine variant (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variant {
@@ -41,6 +65,8 @@ pub struct Variant {
     pub drift_rate: f64,
     /// A speed band with other cutting coefficients.
     pub cutting_band: Option<CuttingBand>,
+    /// A smooth bump of the cutting coefficients in log speed.
+    pub cutting_bump: Option<CuttingBump>,
 }
 
 impl Variant {
@@ -51,6 +77,7 @@ impl Variant {
             softening_per_rpm2: 0.0,
             drift_rate: 0.0,
             cutting_band: None,
+            cutting_bump: None,
         }
     }
 
@@ -65,7 +92,8 @@ impl Variant {
             Some(b) if (b.from_rpm..=b.to_rpm).contains(&speed_rpm) => b.factor,
             _ => 1.0,
         };
-        band * (1.0 + self.drift_rate * u)
+        let bump = self.cutting_bump.map_or(1.0, |b| b.factor(speed_rpm));
+        band * bump * (1.0 + self.drift_rate * u)
     }
 
     /// The modal model of a cut at `speed_rpm`, campaign position `u`, and radial immersion
@@ -170,4 +198,30 @@ pub(crate) fn recalibrated_per_mode(
             c.kt_n_per_m2() * cutting_factor,
             c.kn_n_per_m2() * cutting_factor,
         )?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bump's factor is e^a at its centre, e^{a e^{-1/2}} one half-width away on either side
+    /// in ln speed, and tends to 1 far from it (the closed form of its definition).
+    #[test]
+    fn the_cutting_bump_has_its_closed_form() {
+        let b = CuttingBump {
+            center_rpm: 8000.0,
+            width_ln: 0.1,
+            ln_factor: 0.7,
+        };
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-12 * y.abs().max(1.0);
+        assert!(close(b.factor(8000.0), 0.7f64.exp()));
+        let side = (0.7 * (-0.5f64).exp()).exp();
+        assert!(close(b.factor(8000.0 * 0.1f64.exp()), side));
+        assert!(close(b.factor(8000.0 / 0.1f64.exp()), side));
+        assert!((b.factor(16000.0) - 1.0).abs() < 1e-9);
+        let mut v = Variant::new(crate::generator::nominal_milling().unwrap());
+        v.cutting_bump = Some(b);
+        v.drift_rate = 0.5;
+        assert!(close(v.cutting_factor(8000.0, 1.0), 1.5 * 0.7f64.exp()));
+    }
 }

@@ -34,8 +34,9 @@ pub(crate) const DENSE_MAX_DIM: usize = 24;
 pub const DENSE_FALLBACK_MAX_DIM: usize = 1600;
 
 /// Relative accuracy of the dominant Ritz value: residual below this fraction of its modulus, or
-/// a value that no longer moves between cycles (1e-3 of this).
-const KRYLOV_TOL: f64 = 1e-10;
+/// a value that no longer moves between cycles (1e-3 of this). Callers that need less (a
+/// likelihood inside a sampler) pass their own to [`robust_eigenpair`].
+pub const KRYLOV_TOL: f64 = 1e-10;
 /// A new Krylov direction shorter than this fraction of the operator's image counts as a
 /// breakdown (the Krylov space is invariant to round-off): continuing would fill the projected
 /// matrix with noise.
@@ -53,6 +54,7 @@ pub(crate) struct KrylovConfig {
     checks: &'static [usize],
     cycles: usize,
     start_phase: f64,
+    tolerance: f64,
 }
 
 impl KrylovConfig {
@@ -63,6 +65,7 @@ impl KrylovConfig {
         checks: &[8, 12, 16, 20, 24, 28, 32, 36],
         cycles: 60,
         start_phase: 0.7,
+        tolerance: KRYLOV_TOL,
     };
     /// The second attempt when the first does not converge: a larger basis, more cycles,
     /// another start vector.
@@ -72,26 +75,36 @@ impl KrylovConfig {
         checks: &[20, 30, 40, 50],
         cycles: 200,
         start_phase: 2.3,
+        tolerance: KRYLOV_TOL,
     };
+
+    /// This configuration with another relative tolerance.
+    const fn with_tolerance(self, tolerance: f64) -> Self {
+        Self { tolerance, ..self }
+    }
 }
 
 /// The dominant eigenpair of the operator `apply` of dimension `d`: dense for tiny operators,
-/// else Krylov–Schur (from `start` when given), a larger Krylov–Schur run and the dense matrix
-/// `dense()` in turn. An error only when all of them fail.
+/// else Krylov–Schur (from `start` when given) to the relative `tolerance` (a residual below
+/// that fraction of the value's modulus; [`KRYLOV_TOL`] unless the caller needs less), a larger
+/// Krylov–Schur run and the dense matrix `dense()` in turn. An error only when all of them fail.
 pub(crate) fn robust_eigenpair<F: Fn(&[f64], &mut [f64])>(
     apply: F,
     d: usize,
     dense: impl Fn() -> DMatrix<f64>,
     start: Option<&[f64]>,
+    tolerance: f64,
 ) -> Result<(Complex64, Vec<Complex64>)> {
     if d <= DENSE_MAX_DIM {
         return dense_eigenpair(dense());
     }
-    let first = match krylov_schur(&apply, d, &KrylovConfig::DEFAULT, start) {
+    let first = KrylovConfig::DEFAULT.with_tolerance(tolerance);
+    let first = match krylov_schur(&apply, d, &first, start) {
         Ok(pair) => return Ok(pair),
         Err(e) => e,
     };
-    let second = match krylov_schur(&apply, d, &KrylovConfig::FALLBACK, None) {
+    let second = KrylovConfig::FALLBACK.with_tolerance(tolerance);
+    let second = match krylov_schur(&apply, d, &second, None) {
         Ok(pair) => return Ok(pair),
         Err(e) => e,
     };
@@ -378,10 +391,14 @@ pub(crate) fn krylov_schur<F: Fn(&[f64], &mut [f64])>(
             let settled = |theta: Complex64| {
                 kk == m
                     && previous
-                        .is_some_and(|p| (p - theta).norm() <= 1e-3 * KRYLOV_TOL * theta.norm())
+                        .is_some_and(|p| {
+                            (p - theta).norm() <= 1e-3 * config.tolerance * theta.norm()
+                        })
             };
             let converged = |theta: Complex64, residual: f64| {
-                breakdown || residual <= KRYLOV_TOL * theta.norm().max(1e-300) || settled(theta)
+                breakdown
+                    || residual <= config.tolerance * theta.norm().max(1e-300)
+                    || settled(theta)
             };
             // the cheap test first: the Francis iteration on the projected matrix (Hessenberg
             // in a plain Arnoldi cycle, reduced to it after a restart)
@@ -541,7 +558,7 @@ mod tests {
             assert!(krylov_schur(apply, d, &KrylovConfig::DEFAULT, None).is_err());
             calls.set(0);
             let dense = || DMatrix::from_fn(d, d, |i, j| if i == j { diagonal(i) } else { 0.0 });
-            let (mu, _) = robust_eigenpair(apply, d, dense, None).unwrap();
+            let (mu, _) = robust_eigenpair(apply, d, dense, None, KRYLOV_TOL).unwrap();
             assert!((mu - 0.9).norm() < 1e-10, "{bad}: {mu}");
         }
     }

@@ -41,7 +41,7 @@ use crate::StabilitySolver;
 use crate::eigen::dense_eigenvalues;
 use crate::error::{Result, check_condition};
 use crate::grid::segments;
-pub use crate::krylov::DENSE_FALLBACK_MAX_DIM;
+pub use crate::krylov::{DENSE_FALLBACK_MAX_DIM, KRYLOV_TOL};
 use crate::krylov::{DENSE_MAX_DIM, largest, robust_eigenpair};
 use crate::multiplier::DominantMultiplier;
 pub use crate::step::StepPlan;
@@ -645,12 +645,25 @@ impl Monodromy {
         &self,
         start: Option<&[f64]>,
     ) -> Result<(Complex64, Vec<Complex64>)> {
+        self.dominant_eigenpair_within(start, KRYLOV_TOL)
+    }
+
+    /// [`Self::dominant_eigenpair_from`] to the relative tolerance `tolerance` (the Krylov
+    /// residual below that fraction of |mu|) instead of [`KRYLOV_TOL`]: for callers that need
+    /// |mu| to a few digits many thousand times (a likelihood inside a sampler), where the
+    /// default's last digits cost most of the iteration.
+    pub fn dominant_eigenpair_within(
+        &self,
+        start: Option<&[f64]>,
+        tolerance: f64,
+    ) -> Result<(Complex64, Vec<Complex64>)> {
         let d = self.dimension();
         robust_eigenpair(
             |x, out| self.apply(x, out),
             d,
             || self.dense(),
             start.filter(|s| s.len() == d),
+            tolerance,
         )
     }
 
@@ -662,6 +675,7 @@ impl Monodromy {
             self.dimension(),
             || self.dense().transpose(),
             None,
+            KRYLOV_TOL,
         )
     }
 

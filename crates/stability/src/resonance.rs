@@ -18,7 +18,7 @@
 //! repeated while the dominant multiplier of the deflated operator is rejected.
 
 use crate::error::{Result, StabilityError};
-use crate::krylov::robust_eigenpair;
+use crate::krylov::{KRYLOV_TOL, robust_eigenpair};
 use crate::monodromy::{Discretization, Monodromy};
 use crate::multiplier::DominantMultiplier;
 use chatter_dynamics::ModalModel;
@@ -146,7 +146,13 @@ impl Monodromy {
                 deflate(&deflated, x, out, false);
             };
             let (mu, right) =
-                robust_eigenpair(apply, d, || deflated_dense(self, &deflated, false), None)?;
+                robust_eigenpair(
+                    apply,
+                    d,
+                    || deflated_dense(self, &deflated, false),
+                    None,
+                    KRYLOV_TOL,
+                )?;
             if let Some(accepted) = accept(mu, &right) {
                 return Ok(accepted);
             }
@@ -164,6 +170,7 @@ impl Monodromy {
                 d,
                 || deflated_dense(self, &deflated, true),
                 None,
+                KRYLOV_TOL,
             )?;
             let real = mu.im.abs() <= 1e-10 * mu.norm();
             let (v, w) = (real_basis(&right, real), real_basis(&left, real));

@@ -132,6 +132,17 @@ pub fn run(dir: &Path, observer: &dyn Observer) -> chatter_gap::Result<()> {
                 d.nominal_check,
                 d.predictive_check
             );
+            for c in d.classes.iter().filter(|c| !c.name.is_listed()) {
+                let p: Vec<String> = c
+                    .parameters
+                    .iter()
+                    .map(|(k, v)| format!("{k} {:.3} +- {:.3}", v.mean, v.sd))
+                    .collect();
+                println!("    {}: {}", c.name, p.join(", "));
+            }
+            for note in &d.notes {
+                println!("    note: {note}");
+            }
         }
         let e = table.entry((machine, magnitude)).or_default();
         e.0 += usize::from(right);
