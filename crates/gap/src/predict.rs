@@ -230,7 +230,8 @@ pub(crate) fn predict_cut(
 
 /// Relative accuracy of a milling multiplier inside the likelihood (the Krylov residual over
 /// |mu|): the labels resolve ln|mu| to about 0.03 and an identified pole's damping to 20 %, so
-/// 1e-7 is far below what any observation can see, where the solver's default (1e-10) spends
+/// 1e-7 (a multiplier within 2e-5 of |mu| of the default's: the residual times the eigenvalue's
+/// condition number) is far below what any observation can see, where the default (1e-10) spends
 /// iterations on the last digits: on the outside proving ground's two-mode campaign (`public_16`,
 /// 39 cuts, 8 poles) the diagnosis took 163 s of CPU instead of 195 s, every class's ln evidence
 /// within 0.4 of the default's (the sampler's own scatter is 1-2.5).
@@ -427,8 +428,8 @@ mod tests {
         assert_eq!(resampled_start(&start, 4 + 3 * 7, 3), None);
     }
 
-    /// The warm-started multiplier of a variant equals the cold one, and both the one at the
-    /// solver's default tolerance, to the inference tolerance.
+    /// The warm- and the cold-started multiplier of a variant at the inference tolerance equal
+    /// the one at the solver's default tolerance to 1e-4 of |mu| (measured: 2e-5).
     #[test]
     fn a_warm_start_gives_the_same_multiplier() {
         let model = crate::generator::nominal_milling().unwrap();
@@ -442,9 +443,11 @@ mod tests {
             .dominant_eigenpair()
             .unwrap()
             .0;
+        // the eigenvalue's error is the residual times its condition number (a monodromy
+        // operator is far from normal): 1e-4 of |mu| is 0.3 % of the labels' width in ln|mu|
         for mu in [warm.value, cold.value] {
             assert!(
-                (mu - exact).norm() < 10.0 * INFERENCE_TOLERANCE * exact.norm(),
+                (mu - exact).norm() < 1e-4 * exact.norm(),
                 "{mu} against {exact}"
             );
         }
