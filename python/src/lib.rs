@@ -363,8 +363,8 @@ fn sensitivity<'py>(
         map: transition_map(map).map_err(value_error)?,
         ..defaults
     };
-    let out = run_detached(py, move |_| Sensitivity::new(&m, &request)?.run())?
-        .map_err(value_error)?;
+    let out =
+        run_detached(py, move |_| Sensitivity::new(&m, &request)?.run())?.map_err(value_error)?;
     from_json(py, &out.to_json().to_string())
 }
 
