@@ -341,6 +341,54 @@ fn multiplier<'py>(
     Ok(d)
 }
 
+/// d mu / d theta of the dominant pole at one cut (000 Table 3; the `chatter sensitivity` job,
+/// `chatter_jobs::sensitivity`), as the dict of the CLI's JSON.
+#[pyfunction]
+#[pyo3(signature = (model, speed_rpm, depth_mm, parameters=None, steps_per_revolution=None, map="one-step"))]
+fn sensitivity<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    speed_rpm: f64,
+    depth_mm: f64,
+    parameters: Option<Vec<String>>,
+    steps_per_revolution: Option<usize>,
+    map: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    use chatter_jobs::sensitivity::{Sensitivity, SensitivityRequest, transition_map};
+    let m = model_of(model)?;
+    let defaults = SensitivityRequest::new(speed_rpm, depth_mm);
+    let request = SensitivityRequest {
+        parameters,
+        steps_per_revolution: steps_per_revolution.unwrap_or(defaults.steps_per_revolution),
+        map: transition_map(map).map_err(value_error)?,
+        ..defaults
+    };
+    let out =
+        run_detached(py, move |_| Sensitivity::new(&m, &request)?.run())?.map_err(value_error)?;
+    from_json(py, &out.to_json().to_string())
+}
+
+/// The tool-tip FRF of a tool-holder-spindle assembly file by receptance coupling (004 Eq. 1-4;
+/// the `chatter rcsa` job, `chatter_jobs::rcsa`): `frequency_hz`, `real`, `imag` (m/N).
+#[pyfunction]
+fn rcsa<'py>(py: Python<'py>, assembly: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    use chatter_jobs::rcsa::{RcsaRequest, rcsa as couple};
+    let out = run_detached(py, move |_| couple(&RcsaRequest::from_path(&assembly)?))?
+        .map_err(value_error)?;
+    let tip = &out.tool_tip;
+    let d = PyDict::new(py);
+    d.set_item("frequency_hz", array(py, tip.frequencies_hz().to_vec()))?;
+    d.set_item(
+        "real",
+        array(py, tip.receptance_m_per_n().iter().map(|g| g.re).collect()),
+    )?;
+    d.set_item(
+        "imag",
+        array(py, tip.receptance_m_per_n().iter().map(|g| g.im).collect()),
+    )?;
+    Ok(d)
+}
+
 /// A band job's outcome on a modal model, checked and run on a worker thread.
 fn run_bands(
     py: Python<'_>,
@@ -1072,9 +1120,8 @@ fn campaign_options(
     folds: usize,
 ) -> PyResult<CampaignOptions> {
     Ok(CampaignOptions {
-        samples,
-        paths,
         validation: validation_of(validation, folds)?,
+        ..CampaignOptions::new(samples, paths).map_err(value_error)?
     })
 }
 
@@ -1148,7 +1195,7 @@ fn batch(
     let options = campaign_options(samples, paths, validation, folds)?;
     let campaigns = campaign::read_manifest(&manifest).map_err(value_error)?;
     run_detached(py, move |observer| {
-        campaign::run_batch(&campaigns, &options, observer)
+        campaign::run_batch(&campaigns, &options, observer).map(|b| b.table())
     })?
     .map_err(value_error)
 }
@@ -1204,6 +1251,8 @@ fn _chatter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(lobes, m)?)?;
     m.add_function(wrap_pyfunction!(multiplier, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity, m)?)?;
+    m.add_function(wrap_pyfunction!(rcsa, m)?)?;
     m.add_function(wrap_pyfunction!(bands_geometric, m)?)?;
     m.add_function(wrap_pyfunction!(bands_perturbation, m)?)?;
     m.add_function(wrap_pyfunction!(bands_montecarlo, m)?)?;

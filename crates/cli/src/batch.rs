@@ -1,5 +1,5 @@
-//! `chatter batch`: every machine-tool campaign of a fleet manifest diagnosed and planned in
-//! parallel ([`chatter_jobs::campaign`]), one table row per campaign, written atomically.
+//! `chatter batch`: the options mapped to [`chatter_jobs::campaign`] (every machine-tool
+//! campaign of a fleet manifest diagnosed and planned in parallel), the table written atomically.
 
 use crate::output::{check_file, write_atomic};
 use crate::progress::Bar;
@@ -29,22 +29,16 @@ pub struct BatchArgs {
 pub fn run(args: &BatchArgs, quiet: bool) -> Result<()> {
     check_file("--out", &args.out)?;
     let campaigns = read_manifest(&args.manifest).map_err(crate::job_error)?;
-    let options = CampaignOptions {
-        samples: args.samples,
-        paths: args.paths,
-        ..CampaignOptions::default()
-    };
-    crate::validate::count("--samples", args.samples, 40, 100_000, "samples per class")?;
-    crate::validate::count("--paths", args.paths, 10, 100_000, "sampled boundaries")?;
+    let options = CampaignOptions::new(args.samples, args.paths).map_err(crate::job_error)?;
     let bar = Bar::new(campaigns.len() as u64, "campaigns", quiet);
-    let table = run_batch(&campaigns, &options, &bar).map_err(crate::job_error)?;
+    let outcome = run_batch(&campaigns, &options, &bar).map_err(crate::job_error)?;
     bar.finish();
-    let failed = table.lines().skip(1).filter(|l| !l.ends_with(',')).count();
+    let failed = outcome.failed();
     if failed > 0 {
         eprintln!(
             "warning: {failed} of {} campaigns failed; their rows carry the error",
             campaigns.len()
         );
     }
-    write_atomic(&args.out, table.as_bytes())
+    write_atomic(&args.out, outcome.table().as_bytes())
 }

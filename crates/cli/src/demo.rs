@@ -7,39 +7,13 @@ use crate::output::Folder;
 use crate::plot::{Series, line_chart_svg};
 use crate::progress::Bar;
 use crate::tables::{self, band_series, markers};
-use anyhow::{Result, bail};
-use chatter_dynamics::ModalModel;
+use anyhow::Result;
 use chatter_jobs::bands::BandCurves;
-use chatter_jobs::lobes::{Dynamics, Lobes, LobesRequest};
-use chatter_jobs::synthetic::{SyntheticCampaignRequest, synthetic_campaign};
-use chatter_stability::boundary::LobePoint;
-use chatter_stability::prepared::Method;
+use chatter_jobs::demo::DemoRequest;
 use plotters::style::BLUE;
 use std::path::Path;
 
 pub use crate::report::jobs::CREDIBILITY_TITLE;
-
-/// The limiting depths of `model` by `method` at `speeds_rpm` (the lobe job).
-fn lobes(
-    model: &ModalModel,
-    method: Method,
-    speeds_rpm: Vec<f64>,
-    quiet: bool,
-) -> Result<Vec<LobePoint>> {
-    let dynamics = Dynamics::Modal(model.clone());
-    let request = LobesRequest {
-        method,
-        speeds_rpm: Some(speeds_rpm),
-        ..LobesRequest::default()
-    };
-    let job = Lobes::new(&dynamics, request).map_err(crate::job_error)?;
-    let n = job.speeds_rpm().len();
-    let bar = Bar::new(n as u64, "lobes", quiet || method == Method::Zoa);
-    bar.announce(&format!("{n} speeds, {}", method.name()));
-    let lobes = job.lobes(&bar).map_err(crate::job_error)?;
-    bar.finish();
-    Ok(lobes)
-}
 
 /// What `--out` of `chatter demo` may hold (the folder of its previous run).
 pub const DEMO_FILES: [&str; 17] = [
@@ -65,7 +39,6 @@ pub const DEMO_FILES: [&str; 17] = [
 /// `chatter demo`: the main job on the embedded examples, results into a folder that appears
 /// complete or not at all.
 pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
-    use chatter_dynamics::examples;
     let mut folder = Folder::new("--out", out_dir, &DEMO_FILES)?;
     let mut summary = serde_json::Map::new();
     let stage = |k: usize, what: &str| {
@@ -79,11 +52,12 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         1,
         "turning lobes of the Ahmadi (2022) tool and its test cuts",
     );
-    let turning = examples::ahmadi_2022_turning();
-    let obs = examples::ahmadi_2022_turning_observations();
-    let speeds: Vec<f64> = (0..=120).map(|i| 6800.0 + 7.5 * i as f64).collect();
-    let fdm = lobes(&turning, Method::Fdm, speeds, quiet)?;
-    folder.add("turning_lobes.csv", tables::lobes_csv(&fdm));
+    let request = DemoRequest::default();
+    let stage1 = job_with_bar(quiet, request.turning_speeds_rpm.len(), |bar| {
+        chatter_jobs::demo::turning_lobes(&request, bar)
+    })?;
+    let (turning, obs, fdm) = (&stage1.model, &stage1.observations, &stage1.lobes);
+    folder.add("turning_lobes.csv", tables::lobes_csv(fdm));
     folder.add(
         "turning_lobes.svg",
         line_chart_svg(
@@ -96,42 +70,28 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
                 color: BLUE,
                 dashed: false,
             }],
-            markers(Some(&obs)).as_ref(),
+            markers(Some(obs)).as_ref(),
         )?,
     );
-    let at = |rpm: f64| {
-        fdm.iter()
-            .min_by(|a, b| (a.speed_rpm - rpm).abs().total_cmp(&(b.speed_rpm - rpm).abs()))
-            .map(|p| serde_json::json!({"speed_rpm": p.speed_rpm, "depth_mm": p.depth_mm(), "chatter_hz": p.chatter_hz}))
-    };
-    summary.insert(
-        "turning_limits".into(),
-        serde_json::json!([at(6950.0), at(7150.0), at(7300.0), at(7500.0)]),
-    );
+    let limits: Vec<_> = stage1
+        .limits
+        .iter()
+        .map(|p| serde_json::json!({"speed_rpm": p.speed_rpm, "depth_mm": p.depth_mm(), "chatter_hz": p.chatter_hz}))
+        .collect();
+    summary.insert("turning_limits".into(), serde_json::json!(limits));
 
     // 2. Credibility bounds of the same case after updating (000 Section 6.4, Fig. 8): the
     //    model at the posterior mean of Eq. 34's distribution with its covariance (written out
     //    as a covariance file that `chatter bands --covariance` reads).
     stage(2, "credibility bounds after updating (Eq. 34)");
-    let dist = eq34_distribution(&mut folder)?;
-    let updated = dist.mean_model(&turning)?;
-    let coarse: Vec<f64> = (0..=36).map(|i| 6800.0 + 25.0 * i as f64).collect();
-    let updated_lobes = lobes(&updated, Method::Fdm, coarse.clone(), quiet)?;
-    let Some(depths) = chatter_stability::speed_grid::covering_depths_mm(&updated_lobes, 0.025)
-    else {
-        bail!("no finite limiting depth to cover");
-    };
-    let rule = chatter_uncertainty::perturbation::BoundRule::ComplexSd;
-    let credibility = chatter_jobs::bands::perturbation(
-        &turning,
-        &dist,
-        Method::Fdm,
-        rule,
-        &coarse,
-        Some(depths),
-        &chatter_progress::Silent,
-    )
-    .map_err(crate::job_error)?;
+    folder.add(
+        "eq34_covariance.json",
+        chatter_dynamics::examples::AHMADI_2022_POSTERIOR,
+    );
+    let credibility = job_with_bar(quiet, request.credibility_speeds_rpm.len(), |bar| {
+        chatter_jobs::demo::credibility(&request, turning, bar)
+    })?;
+    let rule = request.credibility_rule;
     let (csv, series) = tables::credibility_bands(&credibility.bounds, rule);
     folder.add("turning_credibility.csv", csv);
     folder.add(
@@ -141,7 +101,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             "spindle speed (rpm)",
             "width of cut (mm)",
             &series,
-            markers(Some(&obs)).as_ref(),
+            markers(Some(obs)).as_ref(),
         )?,
     );
 
@@ -150,14 +110,14 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         3,
         "milling lobes with speed and depth offsets (Schmitz 2023)",
     );
-    let milling = examples::schmitz_2023_milling();
-    let bands = chatter_uncertainty::geometric::schmitz2023::example_boundaries()?;
+    let stage3 = chatter_jobs::demo::milling_bands(&request).map_err(crate::job_error)?;
+    let (milling, bands) = (&stage3.model, &stage3.bands);
     let curve: Vec<(f64, f64)> = bands
         .points
         .iter()
         .map(|p| (p.speed_rpm, p.depth_mm))
         .collect();
-    folder.add("milling_bands.csv", tables::geometric_csv(&bands));
+    folder.add("milling_bands.csv", tables::geometric_csv(bands));
     folder.add(
         "milling_bands.svg",
         line_chart_svg(
@@ -173,27 +133,17 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             None,
         )?,
     );
-    for (name, svg) in crate::bands::offset_detail_svgs("milling_bands", &bands)? {
+    for (name, svg) in crate::bands::offset_detail_svgs("milling_bands", bands)? {
         folder.add(name, svg);
     }
-    let milling_frf = chatter_jobs::frf::frf(
-        &milling,
-        &chatter_jobs::frf::FrfRequest {
-            fmin_hz: Some(0.0),
-            fmax_hz: Some(1500.0),
-            points: 301,
-            ..Default::default()
-        },
-    )
-    .map_err(crate::job_error)?;
-    folder.add("milling_frf.csv", tables::frf_csv(&milling_frf));
+    folder.add("milling_frf.csv", tables::frf_csv(&stage3.frf));
 
     // 4. The seeds' published numbers beside ours, with tolerances.
     stage(
         4,
         "the papers' numbers beside ours (000 Table 3, 001 Sec. 4, 003 Table 2, 004)",
     );
-    let rows = crate::papers::rows(&bands)?;
+    let rows = crate::papers::rows(bands)?;
     folder.add("papers.csv", crate::papers::csv(&rows));
     summary.insert(
         "papers".into(),
@@ -207,12 +157,8 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     // 5. Sim-to-real gap: a synthetic shop-floor campaign of a milling machine whose process
     //    damping the nominal model leaves out, diagnosed from the nominal model and the data.
     stage(5, "sim-to-real gap diagnosis of a synthetic campaign");
-    let (nominal, campaign) = synthetic_campaign(&SyntheticCampaignRequest::new(
-        Some(chatter_gap::EffectClass::ProcessDamping),
-        2.0,
-        101,
-    ))
-    .map_err(crate::job_error)?;
+    let (nominal, campaign) =
+        chatter_jobs::demo::shopfloor_campaign(&request).map_err(crate::job_error)?;
     folder.add(
         "shopfloor_model.json",
         serde_json::to_string_pretty(&chatter_dynamics::ModelFile::from_model(&nominal))?,
@@ -228,10 +174,10 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         &crate::diagnose::DiagnoseRequest {
             model: &model_path,
             observations: &obs_path,
-            seed: 1,
-            samples: 120,
-            validation: crate::diagnose::ValidationArg::Kfold,
-            folds: 3,
+            seed: request.diagnosis.seed,
+            samples: request.diagnosis.samples,
+            validation: validation_arg(request.diagnosis.validation),
+            folds: request.diagnosis.folds(),
             out: Some(&folder.path_of("diagnosis")),
             report: None,
             netcdf: false,
@@ -256,7 +202,7 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
         &[
             (
                 "Turning tool of Ahmadi (2022) (FDM lobes)",
-                BandCurves::of_lobes(&fdm),
+                BandCurves::of_lobes(fdm),
                 "",
                 crate::report::jobs::LOBES_MISSING,
             ),
@@ -268,14 +214,14 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
             ),
             (
                 "Milling example of Schmitz (2023) (offsets 100 rpm, 0.2 mm)",
-                BandCurves::of_offsets(&bands),
+                BandCurves::of_offsets(bands),
                 "lower offset boundary",
                 crate::report::jobs::GEOMETRIC_MISSING,
             ),
         ],
         &[
-            ("turning tool of Ahmadi (2022), hammer-test modes", &turning),
-            ("milling example of Schmitz (2023)", &milling),
+            ("turning tool of Ahmadi (2022), hammer-test modes", turning),
+            ("milling example of Schmitz (2023)", milling),
             ("shop-floor machine: the nominal model diagnosed", &nominal),
         ],
         &diagnosis,
@@ -295,22 +241,25 @@ pub fn demo(out_dir: &Path, quiet: bool) -> Result<()> {
     Ok(())
 }
 
-/// The posterior of 000 Section 6.4 (`chatter_dynamics::examples::ahmadi_2022_posterior`: the
-/// mean and the covariance of Eq. 34 of theta_omega_2, theta_zeta_2, theta_phi_2), written to
-/// `eq34_covariance.json` in `out_dir`.
-fn eq34_distribution(
-    folder: &mut Folder,
-) -> Result<chatter_uncertainty::parameters::ParameterDistribution> {
-    folder.add(
-        "eq34_covariance.json",
-        chatter_dynamics::examples::AHMADI_2022_POSTERIOR,
-    );
-    let posterior = chatter_dynamics::examples::ahmadi_2022_posterior();
-    Ok(chatter_uncertainty::parameters::ParameterDistribution::new(
-        &posterior.parameter_names,
-        posterior.mean,
-        posterior.covariance,
-        None,
-        &folder.path_of("eq34_covariance.json"),
-    )?)
+/// A demo stage run with a progress bar over `speeds` speeds.
+fn job_with_bar<T>(
+    quiet: bool,
+    speeds: usize,
+    job: impl FnOnce(&Bar) -> chatter_jobs::Result<T>,
+) -> Result<T> {
+    let bar = Bar::new(speeds as u64, "lobes", quiet);
+    bar.announce(&format!("{speeds} speeds, fdm"));
+    let out = job(&bar).map_err(crate::job_error)?;
+    bar.finish();
+    Ok(out)
+}
+
+/// The CLI's validation option of a diagnosis request's validation.
+fn validation_arg(v: chatter_gap::Validation) -> crate::diagnose::ValidationArg {
+    use crate::diagnose::ValidationArg;
+    match v {
+        chatter_gap::Validation::KFold { .. } => ValidationArg::Kfold,
+        chatter_gap::Validation::SpeedBands { .. } => ValidationArg::SpeedBands,
+        chatter_gap::Validation::Off => ValidationArg::Off,
+    }
 }

@@ -32,8 +32,6 @@ use anyhow::{Context, Result};
 use chatter_dynamics::SignalRecord;
 use chatter_jobs::oma::{OmaRequest, RecordAnalysis, identify_observations};
 use chatter_oma::Harmonics;
-use chatter_oma::lifting::lift_at_period;
-use chatter_oma::spectrum::first_singular_value;
 use plotters::style::{BLUE, RGBColor};
 use std::path::{Path, PathBuf};
 
@@ -80,28 +78,6 @@ pub struct OmaArgs {
 
 /// `chatter oma`.
 pub fn run(args: &OmaArgs) -> Result<()> {
-    use crate::validate::count;
-    for (flag, value, max, what) in [
-        ("--segments", args.segments, 200, "random segments"),
-        ("--min-order", args.min_order, 200, "model orders"),
-        ("--max-order", args.max_order, 200, "model orders"),
-        ("--decimation", args.decimation, 1000, "a decimation factor"),
-    ] {
-        if let Some(n) = value {
-            count(flag, n, 1, max, what)?;
-        }
-    }
-    crate::output::check_optional_file("--out", args.out.as_deref())?;
-    crate::output::check_optional_file("--plot", args.plot.as_deref())?;
-    let observations = crate::inputs::observations(&args.observations)?;
-    let model = args
-        .model
-        .as_deref()
-        .map(crate::inputs::model)
-        .transpose()?;
-    if let (Some(m), Some(path)) = (&model, &args.model) {
-        crate::validate::observations_match(m, &observations, &args.observations, path)?;
-    }
     let request = OmaRequest {
         min_order: args.min_order,
         max_order: args.max_order,
@@ -115,6 +91,18 @@ pub fn run(args: &OmaArgs) -> Result<()> {
         interference: crate::detect::interference(&args.interference_hz)?,
         allow_chatter: args.allow_chatter,
     };
+    request.check().map_err(crate::job_error)?;
+    crate::output::check_optional_file("--out", args.out.as_deref())?;
+    crate::output::check_optional_file("--plot", args.plot.as_deref())?;
+    let observations = crate::inputs::observations(&args.observations)?;
+    let model = args
+        .model
+        .as_deref()
+        .map(crate::inputs::model)
+        .transpose()?;
+    if let (Some(m), Some(path)) = (&model, &args.model) {
+        crate::validate::observations_match(m, &observations, &args.observations, path)?;
+    }
     let (result, analyses) = identify_observations(
         &observations,
         model.as_ref(),
@@ -181,22 +169,7 @@ fn plot_path(plot: &Path, i: usize, count: usize) -> PathBuf {
 /// singular value of the PSD matrix of the analysed data (the lifted channels for milling), on a
 /// log scale mapped onto the order axis.
 fn draw(path: &Path, record: &SignalRecord, a: &RecordAnalysis) -> Result<()> {
-    let (data, rate_hz) = match a.lifting {
-        Some(l) => {
-            let mut lifted = Vec::new();
-            for ch in &a.signals.data {
-                let all = lift_at_period(ch, a.signals.sample_rate_hz, l.period_s)?;
-                let r = all.len();
-                lifted
-                    .extend((0..l.virtual_sensors).map(|k| all[k * r / l.virtual_sensors].clone()));
-            }
-            (lifted, 1.0 / l.period_s)
-        }
-        None => (a.signals.data.clone(), a.signals.sample_rate_hz),
-    };
-    let len = data.first().map_or(0, Vec::len);
-    let segment = (len / 8).clamp(4, 4096);
-    let psd = first_singular_value(&data, rate_hz, segment)?;
+    let psd = a.psd_first_singular_value()?;
     let orders: Vec<usize> = a
         .identification
         .diagram

@@ -1,11 +1,10 @@
-//! `chatter rcsa`: the tool-tip FRF of a tool-holder-spindle assembly by receptance coupling
-//! (Schmitz et al. 2022, Eq. 1-4; crate `chatter-rcsa`).
+//! `chatter rcsa`: the assembly file mapped to [`chatter_jobs::rcsa`], the tool-tip FRF written
+//! as CSV and plotted.
 
 use crate::output::emit;
 use crate::plot::{Series, line_chart};
 use anyhow::{Context, Result};
-use chatter_frf::text::to_csv;
-use chatter_rcsa::Assembly;
+use chatter_jobs::rcsa::{RcsaRequest, rcsa as couple};
 use plotters::style::BLUE;
 use std::path::PathBuf;
 
@@ -23,16 +22,16 @@ pub struct RcsaArgs {
     plot: Option<PathBuf>,
 }
 
-/// `chatter rcsa`: predict, write the CSV, plot.
+/// `chatter rcsa`: couple, write the CSV, plot.
 pub fn rcsa(args: &RcsaArgs) -> Result<()> {
     crate::output::check_optional_file("--out", args.out.as_deref())?;
     crate::output::check_optional_file("--plot", args.plot.as_deref())?;
-    let assembly = Assembly::from_path(&args.assembly).context("reading the assembly")?;
-    let tip = assembly
-        .tool_tip_frf()
-        .with_context(|| format!("coupling {}", args.assembly.display()))?;
-    emit(args.out.as_deref(), &to_csv(&tip))?;
+    let request = RcsaRequest::from_path(&args.assembly).context("reading the assembly")?;
+    let outcome =
+        couple(&request).with_context(|| format!("coupling {}", args.assembly.display()))?;
+    emit(args.out.as_deref(), &outcome.to_csv())?;
     if let Some(p) = &args.plot {
+        let tip = &outcome.tool_tip;
         let series = [Series {
             label: "tool tip |h| (RCSA)".into(),
             points: tip

@@ -141,24 +141,10 @@ fn parse_classes(spec: &str) -> Result<Vec<f64>> {
 pub fn run(args: &UpdateArgs, quiet: bool) -> Result<()> {
     let mut folder = Folder::new("--out", &args.out, &FILES)?;
     crate::output::check_optional_file("--report", args.report.as_deref())?;
-    crate::validate::count(
-        "--samples",
-        args.samples,
-        10,
-        1_000_000,
-        "samples per class",
-    )?;
     let model = crate::inputs::model(&args.model)?;
     let observations = crate::inputs::observations(&args.observations)?;
     crate::validate::observations_match(&model, &observations, &args.observations, &args.model)?;
     let (priors, joint_prior) = crate::inputs::priors(args.priors.as_deref())?;
-    crate::validate::count(
-        "--surrogate-points",
-        args.surrogate_points,
-        10,
-        1_000_000,
-        "GP training points",
-    )?;
     let request = UpdateRequest {
         sampler: match args.sampler {
             SamplerArg::Itmcmc => Sampler::Itmcmc,

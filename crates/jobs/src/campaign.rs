@@ -109,6 +109,31 @@ impl Default for CampaignOptions {
     }
 }
 
+/// Fewest and most iTMCMC samples per class of a campaign's diagnosis.
+pub const SAMPLES: (usize, usize) = (40, 100_000);
+/// Fewest and most sampled boundaries of a campaign's next-test plan.
+pub const PATHS: (usize, usize) = (10, 100_000);
+
+impl CampaignOptions {
+    /// The options with `samples` per class and `paths` planning paths, checked once
+    /// ([`SAMPLES`], [`PATHS`]); validation off (the row does not use it).
+    pub fn new(samples: usize, paths: usize) -> Result<Self> {
+        crate::error::count(
+            "samples",
+            samples,
+            SAMPLES.0,
+            SAMPLES.1,
+            "samples per class",
+        )?;
+        crate::error::count("paths", paths, PATHS.0, PATHS.1, "sampled boundaries")?;
+        Ok(Self {
+            samples,
+            paths,
+            ..Self::default()
+        })
+    }
+}
+
 /// What a campaign concluded.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct CampaignRow {
@@ -234,44 +259,99 @@ pub fn run_campaign(
     )
 }
 
-/// The table line of a campaign: its row, or its error (a failed campaign does not stop the
-/// batch); `observer` may cancel it.
-pub fn campaign_line(
-    campaign: &Campaign,
-    options: &CampaignOptions,
-    observer: &dyn Observer,
-) -> String {
-    match run_campaign(campaign, options, observer) {
-        Ok(row) => row.csv_line(),
-        Err(e) => error_line(&campaign.name, &e.to_string()),
+/// A campaign's entry in the batch: its row, or the error that stopped it (a failed campaign
+/// does not stop the batch).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CampaignResult {
+    /// The campaign concluded.
+    Row(CampaignRow),
+    /// The campaign failed.
+    Failed {
+        /// The campaign's name.
+        name: String,
+        /// The error in words.
+        error: String,
+    },
+}
+
+impl CampaignResult {
+    /// The line of the batch table.
+    pub fn csv_line(&self) -> String {
+        match self {
+            Self::Row(row) => row.csv_line(),
+            Self::Failed { name, error } => error_line(name, error),
+        }
     }
 }
 
-/// Every campaign in parallel (rayon), the table in manifest order: the header, then one line
-/// per campaign. Each campaign is seeded by its own line, so the table does not depend on the
-/// number of threads; `observer` hears of each finished campaign. A cancel (the observer's)
-/// stops the campaigns under way and skips the others: the batch is then
-/// [`JobError::Cancelled`], not a table of failed lines.
+/// A campaign's row, or its error; `observer` may cancel it.
+pub fn campaign_result(
+    campaign: &Campaign,
+    options: &CampaignOptions,
+    observer: &dyn Observer,
+) -> CampaignResult {
+    match run_campaign(campaign, options, observer) {
+        Ok(row) => CampaignResult::Row(row),
+        Err(e) => CampaignResult::Failed {
+            name: campaign.name.clone(),
+            error: e.to_string(),
+        },
+    }
+}
+
+/// The outcome of a batch: one entry per campaign in manifest order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BatchOutcome {
+    /// The campaigns' entries in manifest order.
+    pub campaigns: Vec<CampaignResult>,
+}
+
+impl BatchOutcome {
+    /// The batch table: the header, then one line per campaign.
+    pub fn table(&self) -> String {
+        let lines: Vec<String> = self
+            .campaigns
+            .iter()
+            .map(CampaignResult::csv_line)
+            .collect();
+        table(&lines)
+    }
+
+    /// How many campaigns failed.
+    pub fn failed(&self) -> usize {
+        self.campaigns
+            .iter()
+            .filter(|c| matches!(c, CampaignResult::Failed { .. }))
+            .count()
+    }
+}
+
+/// Every campaign in parallel (rayon), in manifest order. Each campaign is seeded by its own
+/// line, so the outcome does not depend on the number of threads; `observer` hears of each
+/// finished campaign. A cancel (the observer's) stops the campaigns under way and skips the
+/// others: the batch is then [`JobError::Cancelled`], not a table of failed lines.
 pub fn run_batch(
     campaigns: &[Campaign],
     options: &CampaignOptions,
     observer: &dyn Observer,
-) -> Result<String> {
+) -> Result<BatchOutcome> {
     let finished = std::sync::atomic::AtomicUsize::new(0);
-    let lines: Vec<String> = campaigns
+    let results: Vec<Option<CampaignResult>> = campaigns
         .par_iter()
         .map(|c| {
             if observer.cancelled() {
-                return String::new();
+                return None;
             }
-            let line = campaign_line(c, options, observer);
+            let result = campaign_result(c, options, observer);
             let k = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             observer.steps_done(k, campaigns.len());
-            line
+            Some(result)
         })
         .collect();
     chatter_progress::check(observer)?;
-    Ok(table(&lines))
+    Ok(BatchOutcome {
+        campaigns: results.into_iter().flatten().collect(),
+    })
 }
 
 /// The batch table of lines in order.
@@ -317,12 +397,27 @@ mod tests {
             observations: "/nonexistent/o.json".into(),
             seed: 0,
         };
-        let line = campaign_line(&c, &CampaignOptions::default(), &chatter_progress::Silent);
+        let result = campaign_result(&c, &CampaignOptions::default(), &chatter_progress::Silent);
+        let line = result.csv_line();
         assert!(line.starts_with("\"x,1\",,,,,,,"), "{line}");
         assert!(line.contains("m.json"), "{line}");
-        let t = table(&[line]);
+        let batch = BatchOutcome {
+            campaigns: vec![result],
+        };
+        assert_eq!(batch.failed(), 1);
+        let t = batch.table();
         assert_eq!(t.lines().next(), Some(TABLE_HEADER));
         assert_eq!(t.lines().count(), 2);
+    }
+
+    #[test]
+    fn options_name_the_field_and_value() {
+        let e = CampaignOptions::new(3, 300).unwrap_err().to_string();
+        assert_eq!(e, "samples 3: expected samples per class from 40 to 100000");
+        let e = CampaignOptions::new(120, 5).unwrap_err().to_string();
+        assert_eq!(e, "paths 5: expected sampled boundaries from 10 to 100000");
+        let o = CampaignOptions::new(120, 300).unwrap();
+        assert_eq!(o, CampaignOptions::default());
     }
 
     #[test]

@@ -88,6 +88,9 @@ pub enum JobError {
     /// Measured FRFs and modal fits.
     #[error(transparent)]
     Frf(#[from] chatter_frf::FrfError),
+    /// Receptance coupling of an assembly.
+    #[error(transparent)]
+    Rcsa(#[from] chatter_rcsa::RcsaError),
     /// Operational modal analysis and chatter detection.
     #[error(transparent)]
     Oma(#[from] chatter_oma::OmaError),

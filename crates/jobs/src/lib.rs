@@ -21,11 +21,14 @@
 //! - [`update`]: Bayesian updating (000, 002, 004) with prior draws.
 //! - [`diagnose`]: sim-to-real gap diagnosis ([`chatter_gap`]), also from recordings.
 //! - [`plan`]: the next test cut (003 value of information, 004 risk-based).
+//! - [`rcsa`]: the tool-tip FRF of an assembly by receptance coupling (004).
 //! - [`bands`]: lobes, Type B offsets (001), credibility bounds (000), Monte Carlo (004).
 //! - [`oma`]: operational modal analysis of every signal record of an observations file.
 //! - [`detect`]: chatter detection of a signal record, as a labelled cut with its evidence.
 //! - [`recordings`]: a shop's recordings to labelled cuts and identified poles, one row per
 //!   record.
+//! - [`sensitivity`]: d mu / d theta of the dominant pole at one cut (000 Table 3).
+//! - [`demo`]: the demo's stages on the embedded examples, its grids and seeds in one request.
 //! - [`simulate`]: a time-domain regenerative cut from checked options.
 //! - [`synthetic`]: the synthetic shop-floor campaign of the proving ground (demo and Python).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
@@ -36,6 +39,7 @@
 pub mod bands;
 pub mod campaign;
 pub mod checks;
+pub mod demo;
 pub mod detect;
 pub mod diagnose;
 pub mod error;
@@ -46,7 +50,9 @@ pub mod lobes;
 pub mod multiplier;
 pub mod oma;
 pub mod plan;
+pub mod rcsa;
 pub mod recordings;
+pub mod sensitivity;
 pub mod simulate;
 pub mod synthetic;
 pub mod update;

@@ -46,6 +46,50 @@ pub struct OmaRequest {
     pub allow_chatter: bool,
 }
 
+/// Most random segments, model orders of an identification.
+pub const MAX_SEGMENTS_OR_ORDER: usize = 200;
+/// Largest decimation factor.
+pub const MAX_DECIMATION: usize = 1000;
+
+impl OmaRequest {
+    /// Check the overrides once: segments and model orders from 1 to
+    /// [`MAX_SEGMENTS_OR_ORDER`], a decimation factor from 1 to [`MAX_DECIMATION`]
+    /// ([`identify_observations`] runs it before any record is read).
+    pub fn check(&self) -> Result<()> {
+        for (field, value, max, what) in [
+            (
+                "segments",
+                self.segments,
+                MAX_SEGMENTS_OR_ORDER,
+                "random segments",
+            ),
+            (
+                "min_order",
+                self.min_order,
+                MAX_SEGMENTS_OR_ORDER,
+                "model orders",
+            ),
+            (
+                "max_order",
+                self.max_order,
+                MAX_SEGMENTS_OR_ORDER,
+                "model orders",
+            ),
+            (
+                "decimation",
+                self.decimation,
+                MAX_DECIMATION,
+                "a decimation factor",
+            ),
+        ] {
+            if let Some(n) = value {
+                crate::error::count(field, n, 1, max, what)?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One identified record.
 #[derive(Debug, Clone)]
 pub struct RecordAnalysis {
@@ -61,6 +105,38 @@ pub struct RecordAnalysis {
     pub chatter_hz: Option<f64>,
     /// The interference the chatter check left out, as a clause of the pole's note.
     pub interference: String,
+}
+
+impl RecordAnalysis {
+    /// The first singular value of the Welch PSD matrix of the analysed data (the channels
+    /// lifted at the tooth period, two virtual sensors each, for a milling record; Welch
+    /// segments of an eighth of the record, 4 to 4096 samples): the background of the
+    /// stabilization diagram (000 Fig. 3a).
+    pub fn psd_first_singular_value(&self) -> Result<chatter_oma::spectrum::Spectrum> {
+        let (data, rate_hz) = match self.lifting {
+            Some(l) => {
+                let mut lifted = Vec::new();
+                for ch in &self.signals.data {
+                    let all = chatter_oma::lifting::lift_at_period(
+                        ch,
+                        self.signals.sample_rate_hz,
+                        l.period_s,
+                    )?;
+                    let r = all.len();
+                    lifted.extend(
+                        (0..l.virtual_sensors).map(|k| all[k * r / l.virtual_sensors].clone()),
+                    );
+                }
+                (lifted, 1.0 / l.period_s)
+            }
+            None => (self.signals.data.clone(), self.signals.sample_rate_hz),
+        };
+        let len = data.first().map_or(0, Vec::len);
+        let segment = (len / 8).clamp(4, 4096);
+        Ok(chatter_oma::spectrum::first_singular_value(
+            &data, rate_hz, segment,
+        )?)
+    }
 }
 
 /// The channels of record `i`: CSV at the entry's rate, WAV or MP3 at their own.
@@ -283,6 +359,7 @@ pub fn identify_observations(
     request: &OmaRequest,
     observer: &dyn Observer,
 ) -> Result<(Observations, Vec<RecordAnalysis>)> {
+    request.check()?;
     if observations.signals.is_empty() {
         return Err(JobError::Invalid {
             field: "observations",

@@ -24,6 +24,8 @@ from ._chatter import (  # noqa: F401
     load_observations,
     lobes,
     multiplier,
+    rcsa,
+    sensitivity,
     oma,
     oma_observations,
     plan,

@@ -30,6 +30,21 @@ def lobes(model: Source, speeds_rpm: Optional[Array] = None, method: str = "fdm"
     ``method``: "zoa", "fdm" or "sdm"; default speeds those of ``chatter lobes``: the dominant
     mode's lobes, evenly spaced in lobe number (20 speeds per lobe, 200-2000 speeds)."""
 
+def sensitivity(
+    model: Source,
+    speed_rpm: float,
+    depth_mm: float,
+    parameters: Optional[list[str]] = None,
+    steps_per_revolution: Optional[int] = None,
+    map: str = "one-step",
+) -> dict:
+    """d mu / d theta of the dominant pole at one cut (000 Table 3): the JSON of
+    ``chatter sensitivity`` as a dict (``eigenvalue``, ``chatter_hz``, ``sensitivities``)."""
+
+def rcsa(assembly: Union[str, PathLike]) -> dict:
+    """Tool-tip FRF of an assembly file by receptance coupling (004 Eq. 1-4): ``frequency_hz``,
+    ``real``, ``imag`` (m/N)."""
+
 def multiplier(
     model: Source,
     speed_rpm: float,
