@@ -8,7 +8,7 @@
 //! for the defaults), checked once into the job (linfa's checked parameters, `ParamGuard`):
 //! [`lobes::Lobes::new`], [`bands::Bands::new`], [`multiplier::Multiplier::new`],
 //! [`fit_frf::FitFrfRequest::check`], [`simulate::SimulateRequest::check`],
-//! [`update::PreparedUpdate::new`]. The checks are those of [`checks`]: ranges, the cost guard
+//! [`update::PreparedUpdate::new`], [`sle::Sle::new`], [`recommend::Recommend::new`]. The checks are those of [`checks`]: ranges, the cost guard
 //! [`checks::MAX_STEPS_PER_DELAY`] and the combinations a job refuses. Outcomes are typed
 //! (`LobesOutcome`, `BandsOutcome` with its `curves()`, `MultiplierOutcome`, ...), so summaries
 //! are computed from numbers, never from the text a front end wrote.
@@ -26,6 +26,10 @@
 //! - [`detect`]: chatter detection of a signal record, as a labelled cut with its evidence.
 //! - [`recordings`]: a shop's recordings to labelled cuts and identified poles, one row per
 //!   record.
+//! - [`sle`]: the surface location error of stable milling cuts over speeds (Schmitz & Mann
+//!   2006), with |mu| to mark the unstable ones.
+//! - [`recommend`]: the highest-MRR cut stable with probability >= 1 - P (derated nominal
+//!   lobes, posterior samples or bands) within an SLE tolerance, and the Harmonizer's speeds.
 //! - [`simulate`]: a time-domain regenerative cut from checked options.
 //! - [`synthetic`]: the synthetic shop-floor campaign of the proving ground (demo and Python).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
@@ -46,8 +50,10 @@ pub mod lobes;
 pub mod multiplier;
 pub mod oma;
 pub mod plan;
+pub mod recommend;
 pub mod recordings;
 pub mod simulate;
+pub mod sle;
 pub mod synthetic;
 pub mod update;
 
