@@ -92,7 +92,7 @@ pub fn stacked_line_charts_svg(panels: &[Panel]) -> Result<String> {
             )
             .collect()
     };
-    let (x0, x1) = finite_range(panels.iter().flat_map(|p| points(p)).map(|p| p.0))
+    let (x0, x1) = finite_range(panels.iter().flat_map(&points).map(|p| p.0))
         .ok_or_else(|| anyhow!("nothing to plot"))?;
     let mut svg = String::new();
     {

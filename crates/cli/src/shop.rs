@@ -5,7 +5,9 @@ use crate::output::{check_optional_file, emit};
 use crate::plot::{Series, line_chart};
 use crate::{inputs, validate};
 use anyhow::{Result, bail};
-use chatter_jobs::recommend::{Basis, BandsTable, Evidence, LowerBand, Recommend, RecommendOutcome};
+use chatter_jobs::recommend::{
+    BandsTable, Basis, Evidence, LowerBand, Recommend, RecommendOutcome,
+};
 use chatter_jobs::sle::{Sle, SleOutcome, SleRequest as SleJob};
 use plotters::style::RGBColor;
 use std::path::Path;
@@ -124,9 +126,9 @@ pub fn recommend(r: RecommendRequest, quiet: bool) -> Result<()> {
             validate::posterior_matches(&model, dir)?;
             Evidence::posterior(dir).map_err(|e| anyhow::anyhow!("--posterior: {e}"))?
         }
-        (None, Some(file)) => Evidence::Bands(
-            BandsTable::read(file).map_err(|e| anyhow::anyhow!("--bands: {e}"))?,
-        ),
+        (None, Some(file)) => {
+            Evidence::Bands(BandsTable::read(file).map_err(|e| anyhow::anyhow!("--bands: {e}"))?)
+        }
         (None, None) => Evidence::Nominal,
     };
     let posterior = matches!(evidence, Evidence::Posterior(_));

@@ -232,7 +232,13 @@ fn polyline(svg: &str, stroke: &str) -> Vec<(f64, f64)> {
         .skip(1)
         .filter(|p| p.split("/>").next().unwrap().contains(stroke))
         .map(|p| {
-            let points = p.split("points=\"").nth(1).unwrap().split('"').next().unwrap();
+            let points = p
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
             points
                 .split_whitespace()
                 .map(|xy| {
@@ -248,8 +254,15 @@ fn polyline(svg: &str, stroke: &str) -> Vec<(f64, f64)> {
 /// The largest residual (pixels) of the least-squares line through (value, pixel).
 fn affine_residual(values: &[f64], pixels: &[f64]) -> f64 {
     let n = values.len() as f64;
-    let (mv, mp) = (values.iter().sum::<f64>() / n, pixels.iter().sum::<f64>() / n);
-    let sxy: f64 = values.iter().zip(pixels).map(|(v, p)| (v - mv) * (p - mp)).sum();
+    let (mv, mp) = (
+        values.iter().sum::<f64>() / n,
+        pixels.iter().sum::<f64>() / n,
+    );
+    let sxy: f64 = values
+        .iter()
+        .zip(pixels)
+        .map(|(v, p)| (v - mv) * (p - mp))
+        .sum();
     let sxx: f64 = values.iter().map(|v| (v - mv).powi(2)).sum();
     let slope = sxy / sxx;
     values
@@ -287,7 +300,10 @@ fn lobes_plot_with_the_sle_panel() {
     assert_eq!(code, Some(0), "{err}");
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.contains("Stability lobes (fdm)"), "no lobe panel");
-    assert!(svg.contains("Surface location error at 0.3 mm"), "no SLE panel");
+    assert!(
+        svg.contains("Surface location error at 0.3 mm"),
+        "no SLE panel"
+    );
     // the SLE panel lies under the lobe panel: the SVG is two 560-pixel panels high
     assert!(svg.contains("height=\"1120\""), "{}", &svg[..200]);
     let (code, csv, err) = run(&["sle", "--model", m, "--speeds", speeds, "--depth-mm", "0.3"]);
@@ -297,13 +313,17 @@ fn lobes_plot_with_the_sle_panel() {
         .skip(1)
         .map(|l| l.split(',').map(String::from).collect())
         .collect();
-    assert!(rows.iter().all(|r| r[4] == "true"), "every speed stable at 0.3 mm: {csv}");
+    assert!(
+        rows.iter().all(|r| r[4] == "true"),
+        "every speed stable at 0.3 mm: {csv}"
+    );
     let line = polyline(&svg, "#1F77B4");
     assert_eq!(line.len(), rows.len(), "one vertex per speed");
     let speed: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
     let sle: Vec<f64> = rows.iter().map(|r| r[1].parse().unwrap()).collect();
     let (px, py): (Vec<f64>, Vec<f64>) = line.into_iter().unzip();
-    let span = py.iter().cloned().fold(f64::MIN, f64::max) - py.iter().cloned().fold(f64::MAX, f64::min);
+    let span =
+        py.iter().cloned().fold(f64::MIN, f64::max) - py.iter().cloned().fold(f64::MAX, f64::min);
     assert!(span > 100.0, "the SLE line spans {span} pixels");
     let (rx, ry) = (affine_residual(&speed, &px), affine_residual(&sle, &py));
     eprintln!("residuals: x {rx} px, y {ry} px over {span} px");
@@ -329,7 +349,10 @@ fn lobes_plot_with_the_sle_panel() {
         .fold(f64::INFINITY, f64::min);
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(
-        svg.contains(&format!("Surface location error at {} mm", 0.5 * shallowest)),
+        svg.contains(&format!(
+            "Surface location error at {} mm",
+            0.5 * shallowest
+        )),
         "default depth {}",
         0.5 * shallowest
     );
@@ -360,10 +383,7 @@ fn recommend_from_a_stability_map_and_bad_evidence() {
     }
     std::fs::write(&map, text).unwrap();
     // (risk, speed, depth): 0.05 -> 1 mm at 10 000, 2 mm at 11 000; 0.45 -> 2 and 3 mm
-    for (risk, speed, depth, p) in [
-        ("0.05", 11_000.0, 2.0, 0.96),
-        ("0.45", 11_000.0, 3.0, 0.60),
-    ] {
+    for (risk, speed, depth, p) in [("0.05", 11_000.0, 2.0, 0.96), ("0.45", 11_000.0, 3.0, 0.60)] {
         let (code, json, err) = run(&[
             "recommend",
             "--model",
@@ -378,7 +398,10 @@ fn recommend_from_a_stability_map_and_bad_evidence() {
         assert_eq!(code, Some(0), "{err}");
         let v: serde_json::Value = serde_json::from_str(&json).unwrap();
         assert_eq!(v["cut"]["speed_rpm"].as_f64().unwrap(), speed, "{json}");
-        assert!((v["cut"]["depth_mm"].as_f64().unwrap() - depth).abs() < 1e-12, "{json}");
+        assert!(
+            (v["cut"]["depth_mm"].as_f64().unwrap() - depth).abs() < 1e-12,
+            "{json}"
+        );
         assert_eq!(v["probability_of_stability"].as_f64().unwrap(), p, "{json}");
         assert_eq!(v["basis"], "Monte Carlo probability map");
     }
@@ -439,6 +462,9 @@ fn recommend_from_a_stability_map_and_bad_evidence() {
     ]);
     assert_eq!(code, Some(0), "{err}");
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-    assert!((v["cut"]["depth_mm"].as_f64().unwrap() - 3.2).abs() < 1e-12, "{json}");
+    assert!(
+        (v["cut"]["depth_mm"].as_f64().unwrap() - 3.2).abs() < 1e-12,
+        "{json}"
+    );
     assert!(v["risk"].is_null(), "{json}");
 }

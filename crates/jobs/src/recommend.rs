@@ -93,9 +93,15 @@ pub enum LowerBand {
 impl LowerBand {
     fn describe(self) -> &'static str {
         match self {
-            LowerBand::TypeB => "the Type B lower boundary (001: the lobes offset by the stated speed and depth uncertainties; such offsets carry no probability, so no risk is stated)",
-            LowerBand::Credibility => "the lower credibility bound (000 Eq. 14-18: second-order perturbation of the multiplier; its coverage is the one `chatter bands` was given)",
-            LowerBand::MonteCarloQ05 => "the 5 % quantile of the Monte Carlo limiting depths (004): stable with probability about 95 %",
+            LowerBand::TypeB => {
+                "the Type B lower boundary (001: the lobes offset by the stated speed and depth uncertainties; such offsets carry no probability, so no risk is stated)"
+            }
+            LowerBand::Credibility => {
+                "the lower credibility bound (000 Eq. 14-18: second-order perturbation of the multiplier; its coverage is the one `chatter bands` was given)"
+            }
+            LowerBand::MonteCarloQ05 => {
+                "the 5 % quantile of the Monte Carlo limiting depths (004): stable with probability about 95 %"
+            }
         }
     }
 }
@@ -130,7 +136,8 @@ impl BandsTable {
     /// with `lower_mm`; Type B when it has `theta_deg`, Monte Carlo when it has
     /// `chatter_hz_q05`, credibility bounds otherwise). Empty cells are NaN.
     pub fn read(path: &Path) -> Result<Self> {
-        let mut reader = csv::Reader::from_path(path).map_err(|e| file_error(path, e.to_string()))?;
+        let mut reader =
+            csv::Reader::from_path(path).map_err(|e| file_error(path, e.to_string()))?;
         let header = reader
             .headers()
             .map_err(|e| file_error(path, e.to_string()))?
@@ -166,7 +173,11 @@ impl BandsTable {
                 text.parse::<f64>().map_err(|_| {
                     file_error(
                         path,
-                        format!("row {}: `{text}` in column `{}` is not a number", i + 2, &header[c]),
+                        format!(
+                            "row {}: `{text}` in column `{}` is not a number",
+                            i + 2,
+                            &header[c]
+                        ),
                     )
                 })
             };
@@ -220,7 +231,10 @@ fn map_of(path: &Path, rows: &[[f64; 3]]) -> Result<StabilityMap> {
         ));
     }
     Ok(StabilityMap {
-        p_stable: rows.chunks(per_speed).map(|c| c.iter().map(|r| r[2]).collect()).collect(),
+        p_stable: rows
+            .chunks(per_speed)
+            .map(|c| c.iter().map(|r| r[2]).collect())
+            .collect(),
         samples_per_speed: vec![0; speeds_rpm.len()],
         speeds_rpm,
         depths_mm,
@@ -332,7 +346,11 @@ fn invalid(field: &'static str, value: f64, expected: &str) -> JobError {
 impl<'a> Recommend<'a> {
     /// Check `request` against `model` (milling) and `evidence`, once: ranges, the options the
     /// evidence does not use, the chattering cut given whole, the cost guard of FDM.
-    pub fn new(model: &'a ModalModel, evidence: Evidence, request: RecommendRequest) -> Result<Self> {
+    pub fn new(
+        model: &'a ModalModel,
+        evidence: Evidence,
+        request: RecommendRequest,
+    ) -> Result<Self> {
         let Operation::Milling(milling) = model.operation() else {
             return Err(JobError::Refused(
                 "the recommendation is for milling models (turning given)".into(),
@@ -377,14 +395,21 @@ impl<'a> Recommend<'a> {
         )?;
         let risk = request.risk.unwrap_or(RISK);
         let (risk_ok, risk_expected) = if nominal {
-            (risk > 0.0 && risk <= 0.5, "a probability of chatter in (0, 0.5]")
+            (
+                risk > 0.0 && risk <= 0.5,
+                "a probability of chatter in (0, 0.5]",
+            )
         } else {
-            (risk > 0.0 && risk < 1.0, "a probability of chatter in (0, 1)")
+            (
+                risk > 0.0 && risk < 1.0,
+                "a probability of chatter in (0, 1)",
+            )
         };
         if !(risk.is_finite() && risk_ok) {
             return Err(invalid("risk", risk, risk_expected));
         }
-        if let (Evidence::Bands(BandsTable::Lower { band, .. }), Some(p)) = (&evidence, request.risk)
+        if let (Evidence::Bands(BandsTable::Lower { band, .. }), Some(p)) =
+            (&evidence, request.risk)
             && !(*band == LowerBand::MonteCarloQ05 && p == RISK)
         {
             return Err(JobError::Refused(format!(

@@ -29,7 +29,8 @@ const SPEEDS_RPM: [f64; 6] = [10_600.0, 10_900.0, 11_200.0, 11_500.0, 11_800.0, 
 /// `posterior.csv` with `SAMPLES` seeded draws and their weights.
 fn posterior_folder(dir: &Path) {
     let sd = [0.05, 0.10, 0.05, 0.10];
-    let covariance = nalgebra::DMatrix::from_fn(4, 4, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
+    let covariance =
+        nalgebra::DMatrix::from_fn(4, 4, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
     let draws = gaussian_draws(&[0.0; 4], &covariance, SAMPLES, 7).unwrap();
     let mut csv = NAMES.join(",") + ",weight\n";
     for d in &draws {
@@ -145,25 +146,39 @@ fn bad_requests_name_the_field() {
         assert!(e.contains("(0, 1)"), "{e}");
     }
     // the nominal derating keeps its (0, 0.5]
-    let e = Recommend::new(&model, Evidence::Nominal, RecommendRequest {
-        samples: None,
-        ..request(0.7)
-    })
+    let e = Recommend::new(
+        &model,
+        Evidence::Nominal,
+        RecommendRequest {
+            samples: None,
+            ..request(0.7)
+        },
+    )
     .err()
     .unwrap()
     .to_string();
     assert!(e.contains("(0, 0.5]"), "{e}");
     // options the evidence does not use
-    let e = Recommend::new(&model, evidence.clone(), RecommendRequest {
-        limit_sd_percent: Some(10.0),
-        ..request(0.1)
-    })
+    let e = Recommend::new(
+        &model,
+        evidence.clone(),
+        RecommendRequest {
+            limit_sd_percent: Some(10.0),
+            ..request(0.1)
+        },
+    )
     .err()
     .unwrap()
     .to_string();
-    assert!(e.contains("limit_sd_percent is not used with a posterior"), "{e}");
+    assert!(
+        e.contains("limit_sd_percent is not used with a posterior"),
+        "{e}"
+    );
     // a folder without posterior.csv
     std::fs::remove_file(dir.path().join("posterior.csv")).unwrap();
     let e = Evidence::posterior(dir.path()).err().unwrap().to_string();
-    assert!(e.contains("posterior.csv") && e.contains("not found"), "{e}");
+    assert!(
+        e.contains("posterior.csv") && e.contains("not found"),
+        "{e}"
+    );
 }

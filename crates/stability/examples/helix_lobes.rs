@@ -39,7 +39,10 @@ fn main() {
         let model = cutter(&base, 6.0, &[30.0], slices, None);
         print!("{slices}");
         for s in speeds {
-            print!(",{:.4}", first_crossing_m(&sdm, &model, s, SCAN_STEP_M) * 1e3);
+            print!(
+                ",{:.4}",
+                first_crossing_m(&sdm, &model, s, SCAN_STEP_M) * 1e3
+            );
         }
         println!();
     }
@@ -66,7 +69,9 @@ fn main() {
     let pitched_deg = Some(&[70.0, 110.0, 70.0, 110.0][..]);
     let pitched = mill
         .with_operation(Operation::Milling(
-            m.clone().with_pitch_deg(pitched_deg).expect("valid pitches"),
+            m.clone()
+                .with_pitch_deg(pitched_deg)
+                .expect("valid pitches"),
         ))
         .expect("a valid model");
     let speeds = default_speeds_rpm(&mill);

@@ -54,11 +54,7 @@ fn crossing_time(angle_rad: f64, omega: f64, tau: f64) -> Option<f64> {
 
 /// The segments between the sorted `cuts` of one period tau (cuts closer than 1e-12 tau merged),
 /// each marked by `cutting` at its middle.
-fn between(
-    mut cuts: Vec<f64>,
-    tau: f64,
-    cutting: impl Fn(f64) -> bool,
-) -> Vec<(f64, f64, bool)> {
+fn between(mut cuts: Vec<f64>, tau: f64, cutting: impl Fn(f64) -> bool) -> Vec<(f64, f64, bool)> {
     cuts.sort_by(f64::total_cmp);
     cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
     cuts.windows(2)
