@@ -2,7 +2,7 @@
 //! `chatter_jobs` request, the outcome as CSV, JSON or SVG.
 
 use crate::output::{self, emit, write_atomic};
-use crate::plot::{Series, line_chart};
+use crate::plot::{Panel, Series, line_chart, stacked_line_charts_svg};
 use crate::progress::{Bar, Working};
 use crate::{inputs, tables, validate};
 use anyhow::{Context, Result, bail};
@@ -86,6 +86,21 @@ pub struct LobeExtras<'a> {
     pub map_plot: Option<&'a Path>,
     /// Map depths MIN:MAX:N (mm).
     pub depths: Option<&'a str>,
+    /// The SLE panel under the lobe plot (`--sle`), at this depth (`--sle-depth-mm`; default
+    /// [`sle_panel_depth_mm`]).
+    pub sle: Option<Option<f64>>,
+}
+
+/// Default depth (mm) of the SLE panel of `lobes --plot --sle`: half the shallowest finite
+/// limiting depth over the plotted speeds, so that the cut is stable at every speed by the
+/// lobes (the SLE of a chattering cut is not what the cut leaves) with a factor 2 of margin.
+pub fn sle_panel_depth_mm(lobes: &[chatter_stability::boundary::LobePoint]) -> Option<f64> {
+    lobes
+        .iter()
+        .map(|p| p.depth_mm())
+        .filter(|d| d.is_finite())
+        .min_by(f64::total_cmp)
+        .map(|d| 0.5 * d)
 }
 
 /// `chatter lobes`: the options as a `chatter_jobs::lobes::LobesRequest`, the lobes as CSV and
@@ -110,6 +125,12 @@ pub fn lobes(
         "--depths",
         "without --map-out or --map-plot",
         "the |mu| map",
+    )?;
+    validate::unused(
+        extras.sle.is_some() && plot.is_none(),
+        "--sle",
+        "without --plot",
+        "the SLE panel under the lobe plot",
     )?;
     let obs = observations.map(inputs::observations).transpose()?;
     let request = LobesRequest {
@@ -162,17 +183,55 @@ pub fn lobes(
             color: BLUE,
             dashed: false,
         }];
-        line_chart(
-            p,
-            &format!(
-                "Stability lobes ({}): limiting depth against spindle speed",
-                method.name()
+        let title = format!(
+            "Stability lobes ({}): limiting depth against spindle speed",
+            method.name()
+        );
+        let markers = tables::markers(obs.as_ref());
+        let lobe_panel = Panel {
+            title: &title,
+            x_label: "spindle speed (rpm)",
+            y_label: "depth (mm)",
+            series: &series,
+            markers: markers.as_ref(),
+        };
+        let svg = match (extras.sle, &dynamics) {
+            (None, _) => stacked_line_charts_svg(&[lobe_panel])?,
+            (Some(depth_mm), Dynamics::Modal(model)) => {
+                let depth_mm = match depth_mm {
+                    Some(d) => d,
+                    None => sle_panel_depth_mm(&lobes).ok_or_else(|| {
+                        anyhow::anyhow!(
+                            "--sle: no speed has a finite limiting depth to take half of; give \
+                             --sle-depth-mm"
+                        )
+                    })?,
+                };
+                let sle = crate::shop::sle_outcome(
+                    model,
+                    job.speeds_rpm().to_vec(),
+                    depth_mm,
+                    chatter_jobs::sle::FEED_PER_TOOTH_MM,
+                )?;
+                let sle_title = crate::shop::sle_title(&sle);
+                let sle_series = [crate::shop::sle_series(&sle)];
+                stacked_line_charts_svg(&[
+                    lobe_panel,
+                    Panel {
+                        title: &sle_title,
+                        x_label: "spindle speed (rpm)",
+                        y_label: "SLE (um)",
+                        series: &sle_series,
+                        markers: None,
+                    },
+                ])?
+            }
+            (Some(_), Dynamics::Measured(_)) => bail!(
+                "--sle: the surface location error needs a modal model; the model has measured \
+                 FRFs only"
             ),
-            "spindle speed (rpm)",
-            "depth (mm)",
-            &series,
-            tables::markers(obs.as_ref()).as_ref(),
-        )?;
+        };
+        write_atomic(p, svg.as_bytes())?;
     }
     Ok(())
 }

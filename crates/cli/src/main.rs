@@ -120,6 +120,13 @@ enum Command {
         /// Depths of the |mu| map MIN:MAX:N (mm); default 80 depths up to 1.5x the deepest limit.
         #[arg(long)]
         depths: Option<String>,
+        /// A second panel under the --plot lobes: the surface location error (um) against speed
+        /// at --sle-depth-mm, 0.05 mm/tooth (as `chatter sle`).
+        #[arg(long)]
+        sle: bool,
+        /// Depth (mm) of the SLE panel; default half the shallowest limiting depth plotted.
+        #[arg(long, requires = "sle")]
+        sle_depth_mm: Option<f64>,
     },
     /// Surface location error of stable milling cuts over speeds (Schmitz & Mann 2006): CSV
     /// speed_rpm,sle_um,peak_to_valley_um,modulus,stable (> 0 undercut, < 0 overcut).
@@ -143,8 +150,9 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
-    /// The highest-MRR stable cut (FDM lobes, limit derated for a risk) within a depth limit
-    /// and an SLE tolerance, and the Harmonizer's speeds for a chattering cut, as JSON.
+    /// The highest-MRR cut stable with probability >= 1 - risk (FDM lobes derated, posterior
+    /// samples or bands) within a depth limit and an SLE tolerance, and the Harmonizer's speeds
+    /// for a chattering cut, as JSON.
     Recommend {
         /// Model file (milling).
         #[arg(long)]
@@ -155,12 +163,25 @@ enum Command {
         /// Largest surface location error allowed (um).
         #[arg(long)]
         sle_tolerance_um: Option<f64>,
-        /// Accepted probability of chatter; default 0.05.
+        /// Accepted probability of chatter; default 0.05 (in (0, 0.5] without evidence, (0, 1)
+        /// with --posterior or a --bands map).
         #[arg(long)]
         risk: Option<f64>,
-        /// Assumed standard deviation of the limiting depth (% of the nominal); default 10.
+        /// Assumed standard deviation of the limiting depth (% of the nominal); default 10;
+        /// without --posterior or --bands only.
         #[arg(long)]
         limit_sd_percent: Option<f64>,
+        /// Posterior folder of `chatter update` (summary.json, posterior.csv): the depth at each
+        /// speed is the risk quantile of the samples' limiting depths.
+        #[arg(long)]
+        posterior: Option<PathBuf>,
+        /// Posterior samples whose boundaries are computed (every k-th); default 200.
+        #[arg(long)]
+        samples: Option<usize>,
+        /// A table of `chatter bands`: its Monte Carlo map (--map-out; any --risk) or its band
+        /// CSV (--out; the lower curve, with the band's own risk).
+        #[arg(long)]
+        bands: Option<PathBuf>,
         /// Feed per tooth (mm) of the SLE and MRR; default 0.05.
         #[arg(long, default_value_t = 0.05)]
         feed_per_tooth_mm: f64,
@@ -437,6 +458,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             map_out,
             map_plot,
             depths,
+            sle,
+            sle_depth_mm,
         } => commands::lobes(
             &model,
             method,
@@ -449,6 +472,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 map_out: map_out.as_deref(),
                 map_plot: map_plot.as_deref(),
                 depths: depths.as_deref(),
+                sle: sle.then_some(sle_depth_mm),
             },
             quiet,
         ),
@@ -473,22 +497,35 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             sle_tolerance_um,
             risk,
             limit_sd_percent,
+            posterior,
+            samples,
+            bands,
             feed_per_tooth_mm,
             speeds,
             chatter_speed_rpm,
             chatter_hz,
             out,
-        } => shop::recommend(&shop::RecommendRequest {
-            model: &model,
-            max_depth_mm,
-            sle_tolerance_um,
-            risk,
-            limit_sd_percent,
-            feed_per_tooth_mm,
-            speeds: speeds.as_deref(),
-            chatter: (chatter_speed_rpm, chatter_hz),
-            out: out.as_deref(),
-        }),
+        } => shop::recommend(
+            shop::RecommendRequest {
+                model: &model,
+                posterior: posterior.as_deref(),
+                bands: bands.as_deref(),
+                samples,
+                job: chatter_jobs::recommend::RecommendRequest {
+                    max_depth_mm,
+                    risk,
+                    limit_sd_percent,
+                    sle_tolerance_um,
+                    feed_per_tooth_mm: Some(feed_per_tooth_mm),
+                    chatter_speed_rpm,
+                    chatter_hz,
+                    ..Default::default()
+                },
+                speeds: speeds.as_deref(),
+                out: out.as_deref(),
+            },
+            quiet,
+        ),
         Command::Multiplier {
             model,
             speed_rpm,

@@ -1,16 +1,14 @@
-//! `chatter sle` and `chatter recommend`: parse, call `chatter_dynamics::sle` and
-//! `chatter_stability::recommend`, write.
+//! `chatter sle` and `chatter recommend`: parse, build the request of
+//! `chatter_jobs::sle` / `chatter_jobs::recommend`, write.
 
 use crate::output::{check_optional_file, emit};
 use crate::plot::{Series, line_chart};
 use crate::{inputs, validate};
 use anyhow::{Result, bail};
-use chatter_dynamics::limits::{DEPTH_MM, SPEED_RPM};
-use chatter_dynamics::sle::surface_location_error;
-use chatter_stability::boundary::BoundaryOptions;
-use chatter_stability::prepared::Method;
-use chatter_stability::recommend::{RecommendOptions, harmonic_speeds, highest_mrr_cut};
-use chatter_stability::speed_grid::default_speeds_rpm;
+use chatter_jobs::recommend::{
+    BandsTable, Basis, Evidence, LowerBand, Recommend, RecommendOutcome,
+};
+use chatter_jobs::sle::{Sle, SleOutcome, SleRequest as SleJob};
 use plotters::style::RGBColor;
 use std::path::Path;
 
@@ -24,156 +22,176 @@ pub struct SleRequest<'a> {
     pub plot: Option<&'a Path>,
 }
 
+/// The SLE job at `speeds_rpm` for `model` (errors in the options' words).
+pub fn sle_outcome(
+    model: &chatter_dynamics::ModalModel,
+    speeds_rpm: Vec<f64>,
+    depth_mm: f64,
+    feed_per_tooth_mm: f64,
+) -> Result<SleOutcome> {
+    let job = Sle::new(
+        model,
+        SleJob {
+            speeds_rpm,
+            depth_mm,
+            feed_per_tooth_mm: Some(feed_per_tooth_mm),
+        },
+    )
+    .map_err(crate::job_error)?;
+    job.run().map_err(crate::job_error)
+}
+
 /// `chatter sle`: CSV `speed_rpm,sle_um,peak_to_valley_um,modulus,stable` (|mu| by FDM at the
 /// depth, so unstable speeds are marked: their forced response is not what the cut leaves).
 pub fn sle(r: &SleRequest) -> Result<()> {
     check_optional_file("--out", r.out)?;
     check_optional_file("--plot", r.plot)?;
-    let depth_mm = validate::option("--depth-mm", r.depth_mm, &DEPTH_MM)?;
-    let feed_mm = validate::option(
-        "--feed-per-tooth-mm",
-        r.feed_per_tooth_mm,
-        &chatter_jobs::simulate::FEED_MM,
-    )?;
     let speeds = validate::speeds(r.speeds)?;
     let model = inputs::model(r.model)?;
-    if let Some(d) = Method::Fdm.discretization() {
-        validate::work_size(&model, d, &speeds, "--speeds")?;
-    }
-    let fdm = Method::Fdm.prepare(&model, &BoundaryOptions::default())?;
+    let outcome = sle_outcome(&model, speeds, r.depth_mm, r.feed_per_tooth_mm)?;
     let mut csv = String::from("speed_rpm,sle_um,peak_to_valley_um,modulus,stable\n");
-    let mut points = Vec::new();
-    for &rpm in &speeds {
-        let s = surface_location_error(&model, rpm, depth_mm * 1e-3, feed_mm * 1e-3)?;
-        let mu = fdm.dominant_multiplier(rpm, depth_mm * 1e-3)?.modulus();
+    for row in &outcome.rows {
         csv.push_str(&format!(
-            "{rpm},{},{},{mu},{}\n",
-            s.sle_m * 1e6,
-            s.peak_to_valley_m * 1e6,
-            mu < 1.0
+            "{},{},{},{},{}\n",
+            row.speed_rpm,
+            row.sle_um,
+            row.peak_to_valley_um,
+            row.modulus,
+            row.stable()
         ));
-        points.push((rpm, if mu < 1.0 { s.sle_m * 1e6 } else { f64::NAN }));
     }
     if let Some(p) = r.plot {
         line_chart(
             p,
-            &format!(
-                "Surface location error at {depth_mm} mm, {feed_mm} mm/tooth (stable speeds; \
-                 > 0 undercut)"
-            ),
+            &sle_title(&outcome),
             "spindle speed (rpm)",
             "SLE (um)",
-            &[Series {
-                label: "SLE".into(),
-                points,
-                color: RGBColor(31, 119, 180),
-                dashed: false,
-            }],
+            &[sle_series(&outcome)],
             None,
         )?;
     }
     emit(r.out, &csv)
 }
 
+/// The title of an SLE plot.
+pub fn sle_title(outcome: &SleOutcome) -> String {
+    format!(
+        "Surface location error at {} mm, {} mm/tooth (stable speeds; > 0 undercut)",
+        outcome.depth_mm, outcome.feed_per_tooth_mm
+    )
+}
+
+/// The SLE (um) over the stable speeds, broken (NaN) at the unstable ones.
+pub fn sle_series(outcome: &SleOutcome) -> Series {
+    Series {
+        label: "SLE".into(),
+        points: outcome
+            .rows
+            .iter()
+            .map(|r| (r.speed_rpm, if r.stable() { r.sle_um } else { f64::NAN }))
+            .collect(),
+        color: RGBColor(31, 119, 180),
+        dashed: false,
+    }
+}
+
 /// Options of `chatter recommend`.
 pub struct RecommendRequest<'a> {
     pub model: &'a Path,
-    pub max_depth_mm: f64,
-    pub sle_tolerance_um: Option<f64>,
-    pub risk: Option<f64>,
-    pub limit_sd_percent: Option<f64>,
-    pub feed_per_tooth_mm: f64,
+    pub posterior: Option<&'a Path>,
+    pub bands: Option<&'a Path>,
+    pub samples: Option<usize>,
+    pub job: chatter_jobs::recommend::RecommendRequest,
     pub speeds: Option<&'a str>,
-    pub chatter: (Option<f64>, Option<f64>),
     pub out: Option<&'a Path>,
 }
 
-/// `chatter recommend`: JSON with the highest-MRR stable cut and, given a chattering speed and
-/// frequency, the Harmonizer's speeds, each with its reasons.
-pub fn recommend(r: &RecommendRequest) -> Result<()> {
+/// `chatter recommend`: JSON with the highest-MRR cut stable with probability >= 1 - P (the
+/// nominal lobes derated, posterior samples or a bands table) and, given a chattering speed
+/// and frequency, the Harmonizer's speeds, each with its reasons.
+pub fn recommend(r: RecommendRequest, quiet: bool) -> Result<()> {
     check_optional_file("--out", r.out)?;
-    let max_depth_mm = validate::option("--max-depth-mm", r.max_depth_mm, &DEPTH_MM)?;
-    let feed_mm = validate::option(
-        "--feed-per-tooth-mm",
-        r.feed_per_tooth_mm,
-        &chatter_jobs::simulate::FEED_MM,
-    )?;
-    let mut options = RecommendOptions::new(max_depth_mm * 1e-3);
-    options.feed_per_tooth_m = feed_mm * 1e-3;
-    if let Some(p) = r.risk {
-        if !(p > 0.0 && p <= 0.5) {
-            bail!(
-                "--risk {}: expected a probability of chatter in (0, 0.5]",
-                validate::as_typed("--risk", p)
-            );
-        }
-        options.risk = p;
+    let mut job = r.job;
+    job.samples = r.samples;
+    if let Some(spec) = r.speeds {
+        job.speeds_rpm = Some(validate::speeds(spec)?);
     }
-    if let Some(s) = r.limit_sd_percent {
-        if !(s.is_finite() && (0.0..50.0).contains(&s)) {
-            bail!(
-                "--limit-sd-percent {}: expected a relative standard deviation from 0 to 50 %",
-                validate::as_typed("--limit-sd-percent", s)
-            );
-        }
-        options.limit_relative_sd = s / 100.0;
-    }
-    if let Some(t) = r.sle_tolerance_um {
-        if !(t.is_finite() && t > 0.0) {
-            bail!(
-                "--sle-tolerance-um {}: expected a tolerance > 0 um",
-                validate::as_typed("--sle-tolerance-um", t)
-            );
-        }
-        options.sle_tolerance_m = Some(t * 1e-6);
-    }
-    let chatter = match r.chatter {
-        (Some(s), Some(f)) => Some((
-            validate::option("--chatter-speed-rpm", s, &SPEED_RPM)?,
-            validate::option(
-                "--chatter-hz",
-                f,
-                &chatter_dynamics::limits::OBSERVED_FREQUENCY_HZ,
-            )?,
-        )),
-        (None, None) => None,
-        (Some(_), None) => bail!("--chatter-speed-rpm needs --chatter-hz"),
-        (None, Some(_)) => bail!("--chatter-hz needs --chatter-speed-rpm"),
-    };
     let model = inputs::model(r.model)?;
-    let chatter_dynamics::Operation::Milling(milling) = model.operation() else {
-        bail!(
-            "--model {}: recommend is for milling models",
-            r.model.display()
-        );
+    let evidence = match (r.posterior, r.bands) {
+        (Some(_), Some(_)) => bail!(
+            "give either --posterior DIR or --bands FILE, not both: the stable depth comes from \
+             one of them"
+        ),
+        (Some(dir), None) => {
+            validate::posterior_matches(&model, dir)?;
+            Evidence::posterior(dir).map_err(|e| anyhow::anyhow!("--posterior: {e}"))?
+        }
+        (None, Some(file)) => {
+            Evidence::Bands(BandsTable::read(file).map_err(|e| anyhow::anyhow!("--bands: {e}"))?)
+        }
+        (None, None) => Evidence::Nominal,
     };
-    let speeds = match r.speeds {
-        Some(spec) => validate::speeds(spec)?,
-        None => default_speeds_rpm(&model),
-    };
-    if let Some(d) = Method::Fdm.discretization() {
-        validate::work_size(&model, d, &speeds, "--speeds")?;
+    let posterior = matches!(evidence, Evidence::Posterior(_));
+    let job = Recommend::new(&model, evidence, job).map_err(crate::job_error)?;
+    let outcome = if posterior {
+        let samples = job_samples(r.samples);
+        let bar = crate::progress::Bar::new(samples as u64, "posterior samples", quiet);
+        job.run(&bar)
+    } else {
+        job.run(&chatter_progress::Silent)
     }
-    let fdm = Method::Fdm.prepare(&model, &BoundaryOptions::default())?;
-    let cut = highest_mrr_cut(&model, fdm.as_ref(), &speeds, &options)?;
-    let harmonizer = match chatter {
-        Some((s, f)) => Some(serde_json::json!({
-            "chatter_speed_rpm": s,
-            "chatter_hz": f,
-            "speeds": harmonic_speeds(milling.teeth(), s, f)?,
-        })),
-        None => None,
-    };
-    let json = serde_json::json!({
-        "model": r.model.display().to_string(),
-        "method": "fdm",
-        "risk": options.risk,
-        "limit_sd_percent": options.limit_relative_sd * 100.0,
-        "feed_per_tooth_mm": feed_mm,
-        "cut": cut,
-        "harmonizer": harmonizer,
-    });
+    .map_err(crate::job_error)?;
+    let json = recommend_json(r.model, &outcome);
     emit(r.out, &(serde_json::to_string_pretty(&json)? + "\n"))
+}
+
+/// The posterior samples a recommendation computes.
+fn job_samples(samples: Option<usize>) -> usize {
+    samples.unwrap_or(chatter_jobs::recommend::POSTERIOR_SAMPLES)
+}
+
+/// The JSON of a recommendation.
+fn recommend_json(model: &Path, o: &RecommendOutcome) -> serde_json::Value {
+    let (basis, extra) = match &o.basis {
+        Basis::Derated { limit_sd_percent } => (
+            "derated nominal fdm lobes",
+            serde_json::json!({ "limit_sd_percent": limit_sd_percent }),
+        ),
+        Basis::Posterior { samples, failures } => (
+            "posterior samples",
+            serde_json::json!({ "samples": samples, "failures": failures }),
+        ),
+        Basis::StabilityMap => ("Monte Carlo probability map", serde_json::json!({})),
+        Basis::LowerBand(LowerBand::TypeB) => ("Type B lower boundary", serde_json::json!({})),
+        Basis::LowerBand(LowerBand::Credibility) => {
+            ("lower credibility bound", serde_json::json!({}))
+        }
+        Basis::LowerBand(LowerBand::MonteCarloQ05) => {
+            ("Monte Carlo 5 % quantile", serde_json::json!({}))
+        }
+    };
+    let harmonizer = o.harmonizer.as_ref().map(|h| {
+        serde_json::json!({
+            "chatter_speed_rpm": h.chatter_speed_rpm,
+            "chatter_hz": h.chatter_hz,
+            "speeds": h.speeds,
+        })
+    });
+    serde_json::json!({
+        "model": model.display().to_string(),
+        "method": "fdm",
+        "basis": basis,
+        "evidence": extra,
+        "risk": o.risk,
+        "limit_sd_percent": match o.basis {
+            Basis::Derated { limit_sd_percent } => Some(limit_sd_percent),
+            _ => None,
+        },
+        "probability_of_stability": o.probability_of_stability,
+        "feed_per_tooth_mm": o.feed_per_tooth_mm,
+        "cut": o.cut,
+        "harmonizer": harmonizer,
+    })
 }
 
 /// `--ssv-amplitude-ratio` and `--ssv-frequency-ratio`: both or neither.

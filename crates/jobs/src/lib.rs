@@ -8,7 +8,7 @@
 //! for the defaults), checked once into the job (linfa's checked parameters, `ParamGuard`):
 //! [`lobes::Lobes::new`], [`bands::Bands::new`], [`multiplier::Multiplier::new`],
 //! [`fit_frf::FitFrfRequest::check`], [`simulate::SimulateRequest::check`],
-//! [`update::PreparedUpdate::new`]. The checks are those of [`checks`]: ranges, the cost guard
+//! [`update::PreparedUpdate::new`], [`sle::Sle::new`], [`recommend::Recommend::new`]. The checks are those of [`checks`]: ranges, the cost guard
 //! [`checks::MAX_STEPS_PER_DELAY`] and the combinations a job refuses. Outcomes are typed
 //! (`LobesOutcome`, `BandsOutcome` with its `curves()`, `MultiplierOutcome`, ...), so summaries
 //! are computed from numbers, never from the text a front end wrote.
@@ -29,6 +29,10 @@
 //!   record.
 //! - [`sensitivity`]: d mu / d theta of the dominant pole at one cut (000 Table 3).
 //! - [`demo`]: the demo's stages on the embedded examples, its grids and seeds in one request.
+//! - [`sle`]: the surface location error of stable milling cuts over speeds (Schmitz & Mann
+//!   2006), with |mu| to mark the unstable ones.
+//! - [`recommend`]: the highest-MRR cut stable with probability >= 1 - P (derated nominal
+//!   lobes, posterior samples or bands) within an SLE tolerance, and the Harmonizer's speeds.
 //! - [`simulate`]: a time-domain regenerative cut from checked options.
 //! - [`synthetic`]: the synthetic shop-floor campaign of the proving ground (demo and Python).
 //! - [`campaign`]: fleet manifests, one row per machine-tool campaign, batches in parallel.
@@ -51,9 +55,11 @@ pub mod multiplier;
 pub mod oma;
 pub mod plan;
 pub mod rcsa;
+pub mod recommend;
 pub mod recordings;
 pub mod sensitivity;
 pub mod simulate;
+pub mod sle;
 pub mod synthetic;
 pub mod update;
 

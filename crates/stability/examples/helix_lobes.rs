@@ -7,7 +7,7 @@
 //! 001's mill with four pitch delays (70-110-70-110 deg) and a 30 deg helix in 20 slices.
 //! `cargo run --release -p chatter-stability --example helix_lobes`.
 
-use chatter_dynamics::{Milling, ModalModel, Operation, examples};
+use chatter_dynamics::{Operation, examples};
 use chatter_progress::Silent;
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::BoundaryOptions;
@@ -16,54 +16,14 @@ use chatter_stability::prepared::Method;
 use chatter_stability::speed_grid::default_speeds_rpm;
 use std::time::Instant;
 
-/// `model` with a `diameter_mm` tool of helix `helix_deg` cut in `slices` axial slices.
-fn helical(model: &ModalModel, diameter_mm: f64, helix_deg: f64, slices: usize) -> ModalModel {
-    let Operation::Milling(m) = model.operation() else {
-        unreachable!("a milling model")
-    };
-    let milling = Milling::new(
-        m.teeth(),
-        m.radial_immersion(),
-        m.direction(),
-        Some(diameter_mm * 1e-3),
-        None,
-    )
-    .and_then(|h| h.with_helix_deg(Some(&[helix_deg])))
-    .and_then(|h| h.with_axial_slices(Some(slices)))
-    .and_then(|h| h.with_pitch_deg(m.pitch_deg().as_deref()))
-    .expect("a valid helical cutter");
-    model
-        .with_operation(Operation::Milling(milling))
-        .expect("a valid model")
-}
+#[path = "../tests/common/cutters.rs"]
+mod cutters;
+use cutters::{cutter, first_crossing_m};
 
-/// The first depth (m) with |mu| = 1 from zero: a scan by 0.05 mm (finer than any band of
-/// either sign here), then 40 bisections. The boundary search of `Method::prepare` assumes no
-/// unstable band below its crossing and steps over the narrow one at 17 600 rpm.
-fn first_crossing_m(solver: &Discretization, model: &ModalModel, speed_rpm: f64) -> f64 {
-    let unstable = |b: f64| {
-        solver
-            .dominant_multiplier(model, speed_rpm, b)
-            .expect("a multiplier")
-            .modulus()
-            >= 1.0
-    };
-    let step = 0.05e-3;
-    let mut hi = step;
-    while !unstable(hi) {
-        hi += step;
-    }
-    let mut lo = hi - step;
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if unstable(mid) {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
+/// The scan step of the first crossing: 0.05 mm, finer than any band of either sign here. The
+/// boundary search of `Method::prepare` assumes no unstable band below its crossing and steps
+/// over the narrow one at 17 600 rpm.
+const SCAN_STEP_M: f64 = 0.05e-3;
 
 fn main() {
     let base = examples::insperger_benchmark(0.05);
@@ -76,15 +36,18 @@ fn main() {
     println!();
     let sdm = Discretization::semi();
     for slices in [1, 2, 5, 10, 20, 40, 80] {
-        let model = helical(&base, 6.0, 30.0, slices);
+        let model = cutter(&base, 6.0, &[30.0], slices, None);
         print!("{slices}");
         for s in speeds {
-            print!(",{:.4}", first_crossing_m(&sdm, &model, s) * 1e3);
+            print!(
+                ",{:.4}",
+                first_crossing_m(&sdm, &model, s, SCAN_STEP_M) * 1e3
+            );
         }
         println!();
     }
     for (label, helix) in [("straight", 0.0), ("30 deg helix", 30.0)] {
-        let model = helical(&base, 6.0, helix, 20);
+        let model = cutter(&base, 6.0, &[helix], 20, None);
         println!("\n{label}: |mu| < 1 '.', else '#'; depth 0.25-10 mm by 0.25 mm");
         for i in 0..=10 {
             let rpm = 17_000.0 + 150.0 * i as f64;
@@ -103,10 +66,11 @@ fn main() {
     let Operation::Milling(m) = mill.operation() else {
         unreachable!("a milling model")
     };
+    let pitched_deg = Some(&[70.0, 110.0, 70.0, 110.0][..]);
     let pitched = mill
         .with_operation(Operation::Milling(
             m.clone()
-                .with_pitch_deg(Some(&[70.0, 110.0, 70.0, 110.0]))
+                .with_pitch_deg(pitched_deg)
                 .expect("valid pitches"),
         ))
         .expect("a valid model");
@@ -120,7 +84,7 @@ fn main() {
         ("70-110-70-110, straight", pitched.clone()),
         (
             "70-110-70-110, 30 deg helix, 20 slices",
-            helical(&pitched, 12.7, 30.0, 20),
+            cutter(&pitched, 12.7, &[30.0], 20, pitched_deg),
         ),
     ] {
         let start = Instant::now();

@@ -32,28 +32,33 @@ pub(crate) fn edge_segments(
         let (entry, exit) = m.entry_exit_rad();
         for edge in edges {
             for angle in [entry, exit] {
-                // times in [0, tau) at which the element reaches `angle` (mod 2 pi)
-                let t0 = (angle - edge.lead_rad).rem_euclid(2.0 * PI) / omega;
-                let t = t0.rem_euclid(tau);
-                if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
-                    cuts.push(t);
-                }
+                cuts.extend(crossing_time(angle - edge.lead_rad, omega, tau));
             }
         }
     }
+    between(cuts, tau, |mid| match model.operation() {
+        Operation::Turning(_) => model.directional_matrix(mid, speed_rpm).abs().max() > 0.0,
+        Operation::Milling(_) => edges
+            .iter()
+            .any(|e| model.edge_directional_matrix(e, mid, speed_rpm).abs().max() > 0.0),
+    })
+}
+
+/// The time in (0, tau) at which a point `angle_rad` ahead of the edge is reached (mod 2 pi)
+/// turning at `omega` rad/s, folded into the period tau; None at the period's ends (within
+/// 1e-12 tau), which are cuts already.
+fn crossing_time(angle_rad: f64, omega: f64, tau: f64) -> Option<f64> {
+    let t = (angle_rad.rem_euclid(2.0 * PI) / omega).rem_euclid(tau);
+    (t > 1e-12 * tau && t < tau * (1.0 - 1e-12)).then_some(t)
+}
+
+/// The segments between the sorted `cuts` of one period tau (cuts closer than 1e-12 tau merged),
+/// each marked by `cutting` at its middle.
+fn between(mut cuts: Vec<f64>, tau: f64, cutting: impl Fn(f64) -> bool) -> Vec<(f64, f64, bool)> {
     cuts.sort_by(f64::total_cmp);
     cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
     cuts.windows(2)
-        .map(|w| {
-            let mid = 0.5 * (w[0] + w[1]);
-            let cutting = match model.operation() {
-                Operation::Turning(_) => model.directional_matrix(mid, speed_rpm).abs().max() > 0.0,
-                Operation::Milling(_) => edges
-                    .iter()
-                    .any(|e| model.edge_directional_matrix(e, mid, speed_rpm).abs().max() > 0.0),
-            };
-            (w[0], w[1], cutting)
-        })
+        .map(|w| (w[0], w[1], cutting(0.5 * (w[0] + w[1]))))
         .collect()
 }
 
@@ -91,23 +96,13 @@ pub(crate) fn envelope_segments(
     let mut cuts = vec![0.0, tau];
     for &(offset, lo, hi) in &envelopes {
         for angle in [entry + lo, exit + hi] {
-            let t = ((angle - offset).rem_euclid(2.0 * PI) / omega).rem_euclid(tau);
-            if t > 1e-12 * tau && t < tau * (1.0 - 1e-12) {
-                cuts.push(t);
-            }
+            cuts.extend(crossing_time(angle - offset, omega, tau));
         }
     }
-    cuts.sort_by(f64::total_cmp);
-    cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12 * tau);
-    cuts.windows(2)
-        .map(|w| {
-            let mid = 0.5 * (w[0] + w[1]);
-            let cutting = envelopes.iter().any(|&(offset, lo, hi)| {
-                let span = exit + hi - (entry + lo);
-                span >= 2.0 * PI
-                    || (omega * mid + offset - (entry + lo)).rem_euclid(2.0 * PI) <= span
-            });
-            (w[0], w[1], cutting)
+    between(cuts, tau, |mid| {
+        envelopes.iter().any(|&(offset, lo, hi)| {
+            let span = exit + hi - (entry + lo);
+            span >= 2.0 * PI || (omega * mid + offset - (entry + lo)).rem_euclid(2.0 * PI) <= span
         })
-        .collect()
+    })
 }

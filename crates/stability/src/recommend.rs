@@ -13,8 +13,9 @@
 //! where b_max is the machine's or tool's depth limit, P the accepted risk of chatter, s the
 //! assumed relative standard deviation of the limiting depth (the nominal lobes carry no
 //! uncertainty of their own: the limit is derated as if b_lim were normal about the nominal
-//! boundary with that spread; bands or a posterior are the principled way and are not used
-//! here), z the standard normal quantile, and the last term the surface location error bound
+//! boundary with that spread; bands or a posterior are the principled way: `chatter-jobs`'s
+//! `recommend` takes the stable depths from them and calls [`best_cut`]), z the standard normal
+//! quantile, and the last term the surface location error bound
 //! when a tolerance T is given (the SLE is linear in the depth, [`chatter_dynamics::sle`]).
 //!
 //! # Harmonizer rule
@@ -134,23 +135,114 @@ pub fn highest_mrr_cut(
     speeds_rpm: &[f64],
     options: &RecommendOptions,
 ) -> Result<Recommendation> {
+    let candidates = derated_depths(solver, speeds_rpm, options)?;
+    let mut r = best_cut(model, &candidates, &options.limits())?;
+    r.reasons = reasons(
+        &r,
+        solver.name(),
+        &options.limits(),
+        derating_reason(&r, solver.name(), options),
+    );
+    Ok(r)
+}
+
+/// The reason of a derated limit (module docs) in plain words, for a recommendation `r` from
+/// the `method` lobes under `options`.
+pub fn derating_reason(r: &Recommendation, method: &str, options: &RecommendOptions) -> String {
+    format!(
+        "the nominal {method} limiting depth there is {:.3} mm; with no posterior or bands \
+         given, it is derated to {:.3} mm (factor {:.3} = 1 - z({:.3}) x {:.0} %: the limit \
+         taken as normal about the nominal lobes with a {:.0} % standard deviation, for a {:.0} \
+         % risk of chatter)",
+        r.limiting_depth_mm,
+        r.derated_depth_mm,
+        options.derating(),
+        1.0 - options.risk,
+        options.limit_relative_sd * 100.0,
+        options.limit_relative_sd * 100.0,
+        options.risk * 100.0
+    )
+}
+
+/// The derated limit of every lobe point of `solver` at `speeds_rpm` (module docs), after
+/// checking `options`.
+pub fn derated_depths(
+    solver: &dyn PreparedSolver,
+    speeds_rpm: &[f64],
+    options: &RecommendOptions,
+) -> Result<Vec<StableDepth>> {
     options.validate()?;
     let derating = options.derating();
-    let lobes = solver.lobes(speeds_rpm, &chatter_progress::Silent)?;
+    Ok(solver
+        .lobes(speeds_rpm, &chatter_progress::Silent)?
+        .iter()
+        .map(|p| StableDepth {
+            speed_rpm: p.speed_rpm,
+            limiting_depth_m: p.depth_m,
+            stable_depth_m: derating * p.depth_m,
+        })
+        .collect())
+}
+
+/// The depth a speed allows before the depth limit and the SLE tolerance: the nominal (or
+/// median) limiting depth and the depth accepted as stable at the chosen risk (the derated
+/// limit, a quantile over posterior samples, the lower curve of a band).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct StableDepth {
+    /// Spindle speed (rpm).
+    pub speed_rpm: f64,
+    /// The nominal or median limiting depth (m); infinite or NaN where there is none.
+    pub limiting_depth_m: f64,
+    /// The depth accepted as stable (m); infinite when stable up to any depth searched, NaN
+    /// where unknown (the speed is skipped).
+    pub stable_depth_m: f64,
+}
+
+/// The limits every recommendation keeps: the depth limit, the SLE tolerance, the feed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CutLimits {
+    /// The deepest cut the tool or machine takes (m).
+    pub max_depth_m: f64,
+    /// SLE tolerance T (m), when the wall's location matters.
+    pub sle_tolerance_m: Option<f64>,
+    /// Feed per tooth (m) of the SLE and the MRR.
+    pub feed_per_tooth_m: f64,
+}
+
+impl RecommendOptions {
+    /// The depth limit, SLE tolerance and feed of these options.
+    pub fn limits(&self) -> CutLimits {
+        CutLimits {
+            max_depth_m: self.max_depth_m,
+            sle_tolerance_m: self.sle_tolerance_m,
+            feed_per_tooth_m: self.feed_per_tooth_m,
+        }
+    }
+}
+
+/// The highest-MRR cut among `candidates` (module docs: b = min(b_max, stable depth,
+/// T / |SLE per unit depth|), maximizing b n); the speeds whose stable depth is NaN are skipped.
+/// The reasons are left empty for the caller, who knows where the stable depths came from
+/// ([`reasons`]). An error when no candidate has a stable depth.
+pub fn best_cut(
+    model: &ModalModel,
+    candidates: &[StableDepth],
+    limits: &CutLimits,
+) -> Result<Recommendation> {
     let mut best: Option<(f64, Recommendation)> = None;
-    for p in &lobes {
-        let derated = derating * p.depth_m;
-        let mut depth = options.max_depth_m.min(derated);
-        let mut limited_by = if options.max_depth_m <= derated {
+    for p in candidates.iter().filter(|p| !p.stable_depth_m.is_nan()) {
+        let derated = p.stable_depth_m;
+        let mut depth = limits.max_depth_m.min(derated);
+        let mut limited_by = if limits.max_depth_m <= derated {
             "max_depth"
         } else {
             "stability"
         };
         let mut sle_um = None;
-        if let Some(tolerance) = options.sle_tolerance_m
+        if let Some(tolerance) = limits.sle_tolerance_m
             && depth > 0.0
         {
-            let sle = surface_location_error(model, p.speed_rpm, depth, options.feed_per_tooth_m)?;
+            let sle = surface_location_error(model, p.speed_rpm, depth, limits.feed_per_tooth_m)?;
             // the SLE is linear in the depth
             let per_depth = sle.sle_m / depth;
             let allowed = tolerance / per_depth.abs();
@@ -167,25 +259,21 @@ pub fn highest_mrr_cut(
                 Recommendation {
                     speed_rpm: p.speed_rpm,
                     depth_mm: depth * 1e3,
-                    limiting_depth_mm: p.depth_m * 1e3,
+                    limiting_depth_mm: p.limiting_depth_m * 1e3,
                     derated_depth_mm: derated * 1e3,
                     sle_um,
-                    mrr_cm3_per_min: mrr_cm3_per_min(model, p.speed_rpm, depth, options),
+                    mrr_cm3_per_min: mrr_cm3_per_min(model, p.speed_rpm, depth, limits),
                     limited_by: limited_by.into(),
                     reasons: Vec::new(),
                 },
             ));
         }
     }
-    let Some((_, mut r)) = best else {
-        return Err(StabilityError::InvalidInput {
-            field: "speeds_rpm",
-            value: 0.0,
-            expected: "at least one speed",
-        });
-    };
-    r.reasons = reasons(&r, solver.name(), options, derating);
-    Ok(r)
+    best.map(|(_, r)| r).ok_or(StabilityError::InvalidInput {
+        field: "speeds_rpm",
+        value: candidates.len() as f64,
+        expected: "at least one speed with a stable depth",
+    })
 }
 
 /// MRR = b a_e f_z N n (cm^3/min) when the tool diameter is known.
@@ -193,14 +281,14 @@ fn mrr_cm3_per_min(
     model: &ModalModel,
     speed_rpm: f64,
     depth_m: f64,
-    options: &RecommendOptions,
+    limits: &CutLimits,
 ) -> Option<f64> {
     match model.operation() {
         chatter_dynamics::Operation::Milling(m) => m.tool_diameter_m().map(|d| {
             depth_m
                 * m.radial_immersion()
                 * d
-                * options.feed_per_tooth_m
+                * limits.feed_per_tooth_m
                 * m.teeth() as f64
                 * speed_rpm
                 * 1e6
@@ -209,11 +297,13 @@ fn mrr_cm3_per_min(
     }
 }
 
-fn reasons(
+/// The reasons of a recommendation in plain words: why this speed, `stability` (where its
+/// stable depth came from, in the caller's words), which limit set the depth and the SLE left.
+pub fn reasons(
     r: &Recommendation,
     method: &str,
-    options: &RecommendOptions,
-    derating: f64,
+    limits: &CutLimits,
+    stability: String,
 ) -> Vec<String> {
     let mut out = vec![
         format!(
@@ -221,29 +311,18 @@ fn reasons(
              among the speeds of the {method} lobe diagram that stay inside the limits below",
             r.speed_rpm, r.depth_mm
         ),
-        format!(
-            "the nominal {method} limiting depth there is {:.3} mm; with no posterior or bands \
-             given, it is derated to {:.3} mm (factor {derating:.3} = 1 - z({:.3}) x {:.0} %: \
-             the limit taken as normal about the nominal lobes with a {:.0} % standard \
-             deviation, for a {:.0} % risk of chatter)",
-            r.limiting_depth_mm,
-            r.derated_depth_mm,
-            1.0 - options.risk,
-            options.limit_relative_sd * 100.0,
-            options.limit_relative_sd * 100.0,
-            options.risk * 100.0
-        ),
+        stability,
     ];
     out.push(match r.limited_by.as_str() {
         "max_depth" => format!(
             "the depth is the maximum depth you allowed ({:.3} mm); the cut is stable with margin",
-            options.max_depth_m * 1e3
+            limits.max_depth_m * 1e3
         ),
         "sle" => format!(
             "the depth is lowered to keep the surface location error within {:.2} um",
-            options.sle_tolerance_m.unwrap_or(0.0) * 1e6
+            limits.sle_tolerance_m.unwrap_or(0.0) * 1e6
         ),
-        _ => "the depth is the derated stability limit".into(),
+        _ => "the depth is the stability limit at the accepted risk (above)".into(),
     });
     if let Some(sle) = r.sle_um {
         out.push(format!(
@@ -251,7 +330,7 @@ fn reasons(
              mm/tooth)",
             sle.abs(),
             if sle >= 0.0 { "undercut" } else { "overcut" },
-            options.feed_per_tooth_m * 1e3
+            limits.feed_per_tooth_m * 1e3
         ));
     }
     out

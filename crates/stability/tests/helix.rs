@@ -17,59 +17,15 @@
 //! - a variable helix (delays along the axis) agrees between FDM and SDM within 1 %.
 #![allow(clippy::unwrap_used)]
 
-use chatter_dynamics::{Milling, ModalModel, Operation, examples};
+use chatter_dynamics::{ModalModel, examples};
 use chatter_stability::StabilitySolver;
 use chatter_stability::boundary::BoundaryOptions;
 use chatter_stability::monodromy::{Discretization, steps};
 use chatter_stability::prepared::Method;
 
-/// `model` with a `diameter_mm` tool, helix `helix_deg` (one or per tooth), `slices` slices and
-/// `pitch_deg`.
-fn cutter(
-    model: &ModalModel,
-    diameter_mm: f64,
-    helix_deg: &[f64],
-    slices: usize,
-    pitch_deg: Option<&[f64]>,
-) -> ModalModel {
-    let Operation::Milling(m) = model.operation() else {
-        panic!("a milling model")
-    };
-    let milling = Milling::new(
-        m.teeth(),
-        m.radial_immersion(),
-        m.direction(),
-        Some(diameter_mm * 1e-3),
-        None,
-    )
-    .unwrap()
-    .with_helix_deg(Some(helix_deg))
-    .unwrap()
-    .with_axial_slices(Some(slices))
-    .unwrap()
-    .with_pitch_deg(pitch_deg)
-    .unwrap();
-    model.with_operation(Operation::Milling(milling)).unwrap()
-}
-
-/// The first depth (m) with |mu| >= 1 from zero: a scan by `step_m`, then 40 bisections.
-fn first_crossing_m(solver: &Discretization, model: &ModalModel, rpm: f64, step_m: f64) -> f64 {
-    let unstable = |b: f64| solver.dominant_multiplier(model, rpm, b).unwrap().modulus() >= 1.0;
-    let mut hi = step_m;
-    while !unstable(hi) {
-        hi += step_m;
-    }
-    let mut lo = hi - step_m;
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if unstable(mid) {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
+#[path = "common/cutters.rs"]
+mod cutters;
+use cutters::{cutter, first_crossing_m};
 
 #[test]
 fn helix_zero_is_the_straight_cutter_to_the_bit() {
