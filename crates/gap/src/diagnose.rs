@@ -741,7 +741,10 @@ pub fn diagnose(
             predict(&fitted[most_probable].mean_variant()?, &data)
         };
         let (reference, name) = if nominal_log_evidence >= evidences[most_probable] {
-            ((nominal_log_evidence, &nominal_prediction), "the nominal model")
+            (
+                (nominal_log_evidence, &nominal_prediction),
+                "the nominal model",
+            )
         } else {
             (
                 (evidences[most_probable], &listed_best),

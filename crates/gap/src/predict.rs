@@ -54,8 +54,8 @@
 
 use crate::data::Dataset;
 use crate::variant::Variant;
-use chatter_dynamics::{ModalModel, Operation};
 use chatter_dynamics::pole::multiplier_pole;
+use chatter_dynamics::{ModalModel, Operation};
 use chatter_stability::StabilitySolver;
 use chatter_stability::frequency_domain::{
     CHATTER_BRANCHES as BRANCHES, FrequencyDomain, chatter_branches, dominant_resonance_pole,

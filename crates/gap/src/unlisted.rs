@@ -75,7 +75,7 @@ pub(crate) fn judge(
     min_log_bayes_factor: f64,
 ) -> Option<UnlistedBand> {
     let log_bayes_factor = band.0 - best.0;
-    if !(log_bayes_factor >= min_log_bayes_factor) {
+    if log_bayes_factor.is_nan() || log_bayes_factor < min_log_bayes_factor {
         return None;
     }
     let (t_band, t_best) = (terms(band.1, data, noise), terms(best.1, data, noise));

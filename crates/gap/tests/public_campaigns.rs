@@ -102,12 +102,11 @@ fn a_trend_none_of_the_listed_effects_has_is_unexplained() {
     assert_eq!(effect, "out_of_list");
     assert_eq!(d.verdict.name(), "unexplained", "{:?}", d.notes);
     let band = d.unlisted.expect("the open alternative's band");
+    assert!(band.log_bayes_factor_without_best >= 10f64.ln(), "{band:?}");
     assert!(
-        band.log_bayes_factor_without_best >= 10f64.ln(),
-        "{band:?}"
-    );
-    assert!(
-        d.notes.iter().any(|n| n.contains("none of the listed effects")),
+        d.notes
+            .iter()
+            .any(|n| n.contains("none of the listed effects")),
         "{:?}",
         d.notes
     );

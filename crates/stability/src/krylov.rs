@@ -390,10 +390,9 @@ pub(crate) fn krylov_schur<F: Fn(&[f64], &mut [f64])>(
             let small = b.view((0, 0), (kk, kk)).into_owned();
             let settled = |theta: Complex64| {
                 kk == m
-                    && previous
-                        .is_some_and(|p| {
-                            (p - theta).norm() <= 1e-3 * config.tolerance * theta.norm()
-                        })
+                    && previous.is_some_and(|p| {
+                        (p - theta).norm() <= 1e-3 * config.tolerance * theta.norm()
+                    })
             };
             let converged = |theta: Complex64, residual: f64| {
                 breakdown

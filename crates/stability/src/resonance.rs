@@ -145,14 +145,13 @@ impl Monodromy {
                 self.apply(x, out);
                 deflate(&deflated, x, out, false);
             };
-            let (mu, right) =
-                robust_eigenpair(
-                    apply,
-                    d,
-                    || deflated_dense(self, &deflated, false),
-                    None,
-                    KRYLOV_TOL,
-                )?;
+            let (mu, right) = robust_eigenpair(
+                apply,
+                d,
+                || deflated_dense(self, &deflated, false),
+                None,
+                KRYLOV_TOL,
+            )?;
             if let Some(accepted) = accept(mu, &right) {
                 return Ok(accepted);
             }

@@ -376,6 +376,9 @@ fn effect_words(c: EffectClass) -> &'static str {
         }
         EffectClass::ExtraMode => "a structural mode that the model lacks",
         EffectClass::Drift => "cutting coefficients drifting over the campaign (tool wear)",
+        EffectClass::SpeedBand => {
+            "an effect confined to a band of speeds, which none of the listed effects describes"
+        }
     }
 }
 
