@@ -35,7 +35,7 @@ pub const DENSE_FALLBACK_MAX_DIM: usize = 1600;
 
 /// Relative accuracy of the dominant Ritz value: residual below this fraction of its modulus, or
 /// a value that no longer moves between cycles (1e-3 of this). Callers that need less (a
-/// likelihood inside a sampler) pass their own to [`robust_eigenpair`].
+/// likelihood inside a sampler) pass their own (`Monodromy::dominant_eigenpair_within`).
 pub const KRYLOV_TOL: f64 = 1e-10;
 /// A new Krylov direction shorter than this fraction of the operator's image counts as a
 /// breakdown (the Krylov space is invariant to round-off): continuing would fill the projected
