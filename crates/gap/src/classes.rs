@@ -32,7 +32,7 @@
 //! U(ln 0.02, ln 0.5) (a band of +-2 % to a trend over a factor 1.6 in speed). A band of
 //! changed cutting coefficients or damping, or cutting coefficients that rise toward low
 //! cutting speed (built-up edge), all look like this to the labels. It is never a verdict: when
-//! it wins ([`crate::diagnose`]), the verdict is `unexplained` with the band named.
+//! it wins ([`crate::diagnose()`]), the verdict is `unexplained` with the band named.
 
 use crate::data::Dataset;
 use crate::error::{GapError, Result};

@@ -12,7 +12,7 @@
 //! - its ln evidence beats the best of the nominal model's likelihood and the listed classes'
 //!   evidences by the Bayes factor an effect needs (`DiagnoseOptions::min_log_bayes_factor`),
 //! - and still does after the observation it helps most is removed (the rule of
-//!   [`crate::influence`]: a band resting on one surprising label is that label's lapse as
+//!   `influence`: a band resting on one surprising label is that label's lapse as
 //!   likely as a band).
 //!
 //! The band's own parameters (more than any listed effect has) are paid for by its evidence
