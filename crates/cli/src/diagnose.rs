@@ -183,7 +183,8 @@ pub fn report_of(
     };
     let progress = Progress {
         bar: Bar::new(
-            (EffectClass::ALL.len() + folds) as u64,
+            // the listed classes, the open alternative `speed_band`, the folds
+            (EffectClass::ALL.len() + 1 + folds) as u64,
             "diagnosing",
             r.quiet,
         ),

@@ -435,8 +435,10 @@ fn diagnose_names_the_hidden_effect_and_writes_plots() {
             "{class}"
         );
     }
+    // the five listed classes and the open alternative `speed_band`
     let classes = report["classes"].as_array().unwrap();
-    assert_eq!(classes.len(), 5);
+    assert_eq!(classes.len(), 6);
+    assert_eq!(classes[5]["name"], "speed_band");
     let total: f64 = classes
         .iter()
         .map(|c| c["probability"].as_f64().unwrap())
