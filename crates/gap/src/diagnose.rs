@@ -757,7 +757,7 @@ pub fn diagnose(
             &band.model.physical(&mean),
             &data,
             &options.noise,
-            options.min_log_bayes_factor,
+            (options.min_log_bayes_factor, options.equivalence_std),
         )
         .map(|u| (u, name))
     });

@@ -13,13 +13,19 @@
 //!   evidences by the Bayes factor an effect needs (`DiagnoseOptions::min_log_bayes_factor`),
 //! - and still does after the observation it helps most is removed (the rule of
 //!   `influence`: a band resting on one surprising label is that label's lapse as
-//!   likely as a band).
+//!   likely as a band),
+//! - and its posterior-mean machine moves some observation's prediction by more than the
+//!   practical equivalence ([`crate::equivalence`]) from the best explanation's: the band
+//!   contains plain recalibration (a factor of 1), so on data without a band its evidence is
+//!   recalibration's up to the sampler's scatter (1-2.5 nats), which a Bayes factor alone would
+//!   read as a band.
 //!
 //! The band's own parameters (more than any listed effect has) are paid for by its evidence
 //! (Occam's factor): on data a listed effect made, that class fits as well with fewer
 //! parameters and wins.
 
 use crate::data::Dataset;
+use crate::equivalence::largest_shift;
 use crate::likelihood::{NoiseModel, terms};
 use crate::predict::Prediction;
 use serde::Serialize;
@@ -40,6 +46,9 @@ pub struct UnlistedBand {
     pub log_bayes_factor: f64,
     /// The same without the observation the band helps most.
     pub log_bayes_factor_without_best: f64,
+    /// The largest move of an observation's prediction from the best explanation's, in noise
+    /// standard deviations ([`crate::equivalence`]).
+    pub practical_shift: f64,
 }
 
 impl UnlistedBand {
@@ -64,15 +73,15 @@ impl UnlistedBand {
 
 /// The rule of the module docs: `band` and `best` are the open alternative's and the best
 /// listed explanation's ln evidence with their posterior-mean predictions, `band_parameters` the
-/// band's physical parameters at its posterior mean ([`crate::classes`]). None when the band is
-/// not believed.
+/// band's physical parameters at its posterior mean ([`crate::classes`]), `equivalence_std` the
+/// practical equivalence in noise standard deviations. None when the band is not believed.
 pub(crate) fn judge(
     band: (f64, &Prediction),
     best: (f64, &Prediction),
     band_parameters: &[(&'static str, f64)],
     data: &Dataset,
     noise: &NoiseModel,
-    min_log_bayes_factor: f64,
+    (min_log_bayes_factor, equivalence_std): (f64, f64),
 ) -> Option<UnlistedBand> {
     let log_bayes_factor = band.0 - best.0;
     if log_bayes_factor.is_nan() || log_bayes_factor < min_log_bayes_factor {
@@ -84,18 +93,22 @@ pub(crate) fn judge(
         .chain((0..data.poles.len()).map(|j| t_band.pole(j) - t_best.pole(j)));
     let largest = gains.filter(|g| g.is_finite()).fold(0.0, f64::max);
     let without = log_bayes_factor - largest;
+    let practical_shift = largest_shift(best.1, band.1, data, noise);
     let value = |name: &str| {
         band_parameters
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(_, v)| *v)
     };
-    (without >= min_log_bayes_factor).then_some(UnlistedBand {
-        cutting_factor: value("band_cutting_factor")?,
-        center_rpm: value("band_center_rpm")?,
-        from_rpm: value("band_from_rpm")?,
-        to_rpm: value("band_to_rpm")?,
-        log_bayes_factor,
-        log_bayes_factor_without_best: without,
-    })
+    (without >= min_log_bayes_factor && practical_shift >= equivalence_std).then_some(
+        UnlistedBand {
+            cutting_factor: value("band_cutting_factor")?,
+            center_rpm: value("band_center_rpm")?,
+            from_rpm: value("band_from_rpm")?,
+            to_rpm: value("band_to_rpm")?,
+            log_bayes_factor,
+            log_bayes_factor_without_best: without,
+            practical_shift,
+        },
+    )
 }
