@@ -29,11 +29,14 @@ fn summary(d: &Diagnosis) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     format!(
-        "verdict {}, nominal ln L {:.1}, nominal check {:?}, best check {:?}; {classes}",
+        "verdict {}, nominal ln L {:.1}, nominal check {:?}, best check {:?}; {classes}; \
+         band {:?}; notes {:?}",
         d.verdict.name(),
         d.nominal_log_evidence,
         d.nominal_check,
-        d.predictive_check
+        d.predictive_check,
+        d.unlisted,
+        d.notes
     )
 }
 
