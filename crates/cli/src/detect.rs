@@ -70,15 +70,8 @@ pub struct DetectArgs {
 /// `chatter detect`.
 pub fn run(args: &DetectArgs) -> Result<()> {
     crate::output::check_optional_file("--out", args.out.as_deref())?;
-    let observations = crate::inputs::observations(&args.observations)?;
-    let model = args
-        .model
-        .as_deref()
-        .map(crate::inputs::model)
-        .transpose()?;
-    if let (Some(m), Some(path)) = (&model, &args.model) {
-        crate::validate::observations_match(m, &observations, &args.observations, path)?;
-    }
+    let (observations, model) =
+        crate::inputs::observations_with_model(&args.observations, args.model.as_deref())?;
     if observations.signals.is_empty() {
         bail!(
             "{}: no `signals` to examine; expected at least one entry with a `file`",

@@ -34,6 +34,20 @@ pub fn observations(path: &Path) -> Result<Observations> {
     Observations::from_path(path).context("reading the observations file")
 }
 
+/// Read an observations file and, when given, a model file checked to match it (the model's
+/// operation against the observations' geometry; `crate::validate::observations_match`).
+pub fn observations_with_model(
+    observations_path: &Path,
+    model_path: Option<&Path>,
+) -> Result<(Observations, Option<ModalModel>)> {
+    let observations = observations(observations_path)?;
+    let model = model_path.map(model).transpose()?;
+    if let (Some(m), Some(path)) = (&model, model_path) {
+        crate::validate::observations_match(m, &observations, observations_path, path)?;
+    }
+    Ok((observations, model))
+}
+
 /// Read a priors file (`--priors` of `update` and `plan`): marginals by name, or one correlated
 /// normal `{"parameter_names", "mean", "covariance"}`; without a file, neither.
 pub fn priors(path: Option<&Path>) -> Result<(PriorOverrides, Option<JointNormal>)> {

@@ -94,15 +94,8 @@ pub fn run(args: &OmaArgs) -> Result<()> {
     request.check().map_err(crate::job_error)?;
     crate::output::check_optional_file("--out", args.out.as_deref())?;
     crate::output::check_optional_file("--plot", args.plot.as_deref())?;
-    let observations = crate::inputs::observations(&args.observations)?;
-    let model = args
-        .model
-        .as_deref()
-        .map(crate::inputs::model)
-        .transpose()?;
-    if let (Some(m), Some(path)) = (&model, &args.model) {
-        crate::validate::observations_match(m, &observations, &args.observations, path)?;
-    }
+    let (observations, model) =
+        crate::inputs::observations_with_model(&args.observations, args.model.as_deref())?;
     let (result, analyses) = identify_observations(
         &observations,
         model.as_ref(),

@@ -609,8 +609,10 @@ pub fn diagnose(
             observations.signals.len()
         ));
     }
+    // the listed classes first, the open alternative last
+    let open = options.unlisted_band.then_some(EffectClass::SpeedBand);
     let mut fitted = Vec::new();
-    for &class in &options.classes {
+    for class in options.classes.iter().copied().chain(open) {
         if let Some(why) = unavailable(class, &nominal, &data) {
             notes.push(why);
             continue;
@@ -627,22 +629,7 @@ pub fn diagnose(
         observer.class_done(class.name(), f.run.log_evidence);
         fitted.push(f);
     }
-    // the listed classes first, the open alternative last
-    let listed = fitted.len();
-    if options.unlisted_band {
-        let class = EffectClass::SpeedBand;
-        let f = fit(
-            class,
-            &nominal,
-            &data,
-            &options,
-            options.samples,
-            class_seed(options.seed, class, 0),
-            observer,
-        )?;
-        observer.class_done(class.name(), f.run.log_evidence);
-        fitted.push(f);
-    }
+    let listed = fitted.iter().filter(|f| f.model.class.is_listed()).count();
     let evidences: Vec<f64> = fitted.iter().map(|f| f.run.log_evidence).collect();
     let probabilities = class_probabilities(&evidences);
     let most_probable = (0..listed)

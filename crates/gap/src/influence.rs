@@ -75,6 +75,20 @@ impl Rule<'_> {
     }
 }
 
+/// Each observation's log-likelihood under `to` less that under `from`, as (pole, index in the
+/// observations' `cuts` or `poles`, gain): the cuts first, then the poles.
+pub(crate) fn gains(
+    from: &Prediction,
+    to: &Prediction,
+    data: &Dataset,
+    noise: &NoiseModel,
+) -> Vec<(bool, usize, f64)> {
+    let (t0, t1) = (terms(from, data, noise), terms(to, data, noise));
+    let cuts = (0..data.cuts.len()).map(|i| (false, i, t1.cut(i) - t0.cut(i)));
+    let poles = (0..data.poles.len()).map(|j| (true, j, t1.pole(j) - t0.pole(j)));
+    cuts.chain(poles).collect()
+}
+
 /// The observation the rejection of the nominal model rests on, if it rests on one (module
 /// docs): `log_bayes_factor` is the alternative's over the nominal model on all of `data`.
 pub(crate) fn lone_observation(
@@ -84,14 +98,8 @@ pub(crate) fn lone_observation(
     log_bayes_factor: f64,
     rule: &Rule,
 ) -> Option<LoneObservation> {
-    let (t0, t1) = (
-        terms(nominal.1, data, rule.noise),
-        terms(candidate.1, data, rule.noise),
-    );
-    let cuts = (0..data.cuts.len()).map(|i| (false, i, t1.cut(i) - t0.cut(i)));
-    let poles = (0..data.poles.len()).map(|j| (true, j, t1.pole(j) - t0.pole(j)));
-    let (pole, at, gain) = cuts
-        .chain(poles)
+    let (pole, at, gain) = gains(nominal.1, candidate.1, data, rule.noise)
+        .into_iter()
         .filter(|(_, _, g)| g.is_finite())
         .max_by(|a, b| a.2.total_cmp(&b.2))?;
     if gain <= 0.0 {

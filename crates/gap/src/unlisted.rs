@@ -26,7 +26,8 @@
 
 use crate::data::Dataset;
 use crate::equivalence::largest_shift;
-use crate::likelihood::{NoiseModel, terms};
+use crate::influence::gains;
+use crate::likelihood::NoiseModel;
 use crate::predict::Prediction;
 use serde::Serialize;
 
@@ -87,11 +88,11 @@ pub(crate) fn judge(
     if log_bayes_factor.is_nan() || log_bayes_factor < min_log_bayes_factor {
         return None;
     }
-    let (t_band, t_best) = (terms(band.1, data, noise), terms(best.1, data, noise));
-    let gains = (0..data.cuts.len())
-        .map(|i| t_band.cut(i) - t_best.cut(i))
-        .chain((0..data.poles.len()).map(|j| t_band.pole(j) - t_best.pole(j)));
-    let largest = gains.filter(|g| g.is_finite()).fold(0.0, f64::max);
+    let largest = gains(best.1, band.1, data, noise)
+        .into_iter()
+        .map(|(_, _, g)| g)
+        .filter(|g| g.is_finite())
+        .fold(0.0, f64::max);
     let without = log_bayes_factor - largest;
     let practical_shift = largest_shift(best.1, band.1, data, noise);
     let value = |name: &str| {
